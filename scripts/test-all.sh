@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Set up everything (npm packages, Debian chromium, the Python venv) and run every suite:
+# pytest (training toolkit), TypeScript typecheck, Vitest (unit + parity), Playwright (browser).
+source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+ensure_node_modules
+ensure_chromium
+ensure_venv
+cd "$REPO_ROOT"
+failed=()
+passed=0
+step() {
+  local name="$1"; shift
+  say "── $name"
+  local t0=$SECONDS
+  if "$@"; then say "$name: ok ($((SECONDS - t0)) s)"; passed=$((passed + 1)); else say "$name: FAILED ($((SECONDS - t0)) s)"; failed+=("$name"); fi
+}
+step "pytest (training/)" bash -c "cd training && PYTHONPATH='$REPO_ROOT/training/src' '$TALKING_FACE_VENV/bin/python' -m pytest -q"
+step "typecheck (tsc)" npx tsc -p .
+step "vitest" npx vitest run
+step "playwright (headless chromium)" npx playwright test
+[ ${#failed[@]} -eq 0 ] || say "failed suites: ${failed[*]}"
+echo "suites: $passed passed, ${#failed[@]} failed"
+[ ${#failed[@]} -eq 0 ]

@@ -1,0 +1,48 @@
+/**
+ * The one place that asks what the browser's GPU can do. Everything that
+ * wants WebGPU goes through here, so a missing adapter is decided once and
+ * reported the same way everywhere.
+ */
+
+export interface WebGPUSupport {
+  available: boolean;
+  /** Human-readable: "google swiftshader (fallback adapter)" or why there is none. */
+  description: string;
+  adapter: GPUAdapter | null;
+  info: { vendor: string; architecture: string; device: string; isFallbackAdapter: boolean } | null;
+}
+
+let cached: Promise<WebGPUSupport> | null = null;
+
+/** Request an adapter once per page; later calls share the answer. */
+export function detectWebGPU(): Promise<WebGPUSupport> {
+  cached ??= probe();
+  return cached;
+}
+
+async function probe(): Promise<WebGPUSupport> {
+  const gpu = (globalThis.navigator as Navigator | undefined)?.gpu;
+  if (!gpu) {
+    return { available: false, description: 'no WebGPU in this browser (navigator.gpu is missing)', adapter: null, info: null };
+  }
+  let adapter: GPUAdapter | null;
+  try {
+    adapter = await gpu.requestAdapter();
+  } catch (e) {
+    return { available: false, description: `WebGPU adapter request failed: ${(e as Error).message}`, adapter: null, info: null };
+  }
+  if (!adapter) {
+    return { available: false, description: 'WebGPU is present but no adapter was found', adapter: null, info: null };
+  }
+  const raw = adapter.info;
+  // isFallbackAdapter moved from GPUAdapter to GPUAdapterInfo; read both.
+  const isFallbackAdapter = Boolean((raw as { isFallbackAdapter?: boolean }).isFallbackAdapter ?? (adapter as { isFallbackAdapter?: boolean }).isFallbackAdapter);
+  const info = { vendor: raw.vendor, architecture: raw.architecture, device: raw.device, isFallbackAdapter };
+  const name = [info.vendor, info.architecture, info.device].filter(Boolean).join(' ') || 'unnamed adapter';
+  return {
+    available: true,
+    description: `${name}${isFallbackAdapter ? ' (fallback adapter, software)' : ''}`,
+    adapter,
+    info,
+  };
+}

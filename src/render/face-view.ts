@@ -1,0 +1,199 @@
+/**
+ * Draws a face template (and later, posed frames y_i = T_p,i (I + O_i)) with three.js:
+ * a shaded skin surface, two eyeballs behind the lid openings and a dark
+ * inner-mouth backing so parted lips never show the void behind the mask.
+ *
+ * The caller owns the canvas. `setVertices` updates the position attribute in
+ * place; nothing is allocated per frame.
+ */
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import type { FaceTemplate } from '../template/face-template';
+
+const SKIN_COLOR = 0xe0ac8e;
+const EYE_COLOR = 0xf4f1ec;
+const IRIS_COLOR = 0x3b2a1e;
+const MOUTH_COLOR = 0x2a0a0c;
+const LIP_COLOR = 0xb8676a;
+
+export class FaceView {
+  readonly renderer: THREE.WebGLRenderer;
+  readonly scene = new THREE.Scene();
+  readonly camera: THREE.PerspectiveCamera;
+  readonly controls: OrbitControls;
+  /** Everything that moves with the head pose T_p. */
+  readonly head = new THREE.Group();
+  private readonly face: THREE.Mesh<THREE.BufferGeometry, THREE.MeshStandardMaterial>;
+  private readonly positions: THREE.BufferAttribute;
+  private readonly resizeObserver: ResizeObserver;
+  private needsRender = true;
+  private frameHandle = 0;
+
+  constructor(
+    private readonly canvas: HTMLCanvasElement,
+    readonly template: FaceTemplate,
+  ) {
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
+    this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
+    this.scene.background = new THREE.Color(0x1d2230);
+
+    const geometry = new THREE.BufferGeometry();
+    this.positions = new THREE.BufferAttribute(new Float32Array(template.positions), 3);
+    this.positions.setUsage(THREE.DynamicDrawUsage);
+    geometry.setAttribute('position', this.positions);
+    if (template.uvs) geometry.setAttribute('uv', new THREE.BufferAttribute(template.uvs, 2));
+    geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
+    geometry.setAttribute('color', new THREE.BufferAttribute(skinColors(template), 3));
+    geometry.computeVertexNormals();
+    geometry.computeBoundingSphere();
+    this.face = new THREE.Mesh(
+      geometry,
+      new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.62, metalness: 0, side: THREE.DoubleSide }),
+    );
+    this.face.name = 'face';
+    this.head.add(this.face);
+    this.addEyes();
+    this.addMouthBacking();
+    this.scene.add(this.head);
+
+    this.scene.add(new THREE.HemisphereLight(0xfff4ea, 0x39303a, 1.1));
+    const key = new THREE.DirectionalLight(0xffffff, 2.0);
+    key.position.set(0.6, 0.8, 1.5);
+    this.scene.add(key);
+    const rim = new THREE.DirectionalLight(0x9ab4ff, 0.6);
+    rim.position.set(-1, 0.4, -0.8);
+    this.scene.add(rim);
+
+    const sphere = geometry.boundingSphere!;
+    this.camera = new THREE.PerspectiveCamera(30, 1, sphere.radius / 20, sphere.radius * 40);
+    this.camera.position.set(sphere.center.x, sphere.center.y, sphere.center.z + sphere.radius * 3.6);
+    this.controls = new OrbitControls(this.camera, canvas);
+    this.controls.target.copy(sphere.center);
+    this.controls.enableDamping = true;
+    this.controls.addEventListener('change', () => this.requestRender());
+    this.controls.update();
+
+    this.resizeObserver = new ResizeObserver(() => this.resize());
+    this.resizeObserver.observe(canvas);
+    this.resize();
+    this.loop();
+  }
+
+  /** Replace the face's vertices (N x 3, template units) in place. */
+  setVertices(vertices: Float32Array): void {
+    if (vertices.length !== this.positions.array.length) {
+      throw new Error(`setVertices: expected ${this.positions.array.length / 3} vertices, got ${vertices.length / 3}`);
+    }
+    (this.positions.array as Float32Array).set(vertices);
+    this.positions.needsUpdate = true;
+    this.face.geometry.computeVertexNormals();
+    this.requestRender();
+  }
+
+  requestRender(): void {
+    this.needsRender = true;
+  }
+
+  dispose(): void {
+    cancelAnimationFrame(this.frameHandle);
+    this.resizeObserver.disconnect();
+    this.controls.dispose();
+    this.scene.traverse((o) => {
+      if (o instanceof THREE.Mesh) {
+        o.geometry.dispose();
+        (o.material as THREE.Material).dispose();
+      }
+    });
+    this.renderer.dispose();
+  }
+
+  private loop = (): void => {
+    this.frameHandle = requestAnimationFrame(this.loop);
+    // Damping keeps moving the camera for a few frames after the pointer stops.
+    if (this.controls.update()) this.needsRender = true;
+    if (!this.needsRender) return;
+    this.needsRender = false;
+    this.renderer.render(this.scene, this.camera);
+  };
+
+  private resize(): void {
+    const w = Math.max(1, this.canvas.clientWidth);
+    const h = Math.max(1, this.canvas.clientHeight);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.requestRender();
+  }
+
+  /** An eyeball behind each lid opening, sized from the opening so any template gets fitting eyes. */
+  private addEyes(): void {
+    const r = this.template.regions;
+    for (const side of ['left', 'right'] as const) {
+      const loop = [...r[`eye_${side}_upper`], ...r[`eye_${side}_lower`]];
+      const { center, size, maxZ } = this.bounds(loop);
+      const radius = size.x * 0.62;
+      const eye = new THREE.Group();
+      eye.name = `eye_${side}`;
+      const ball = new THREE.Mesh(new THREE.SphereGeometry(radius, 32, 16), new THREE.MeshStandardMaterial({ color: EYE_COLOR, roughness: 0.25 }));
+      const iris = new THREE.Mesh(
+        new THREE.CircleGeometry(radius * 0.34, 32),
+        new THREE.MeshStandardMaterial({ color: IRIS_COLOR, roughness: 0.3 }),
+      );
+      iris.position.z = radius * 1.001;
+      eye.add(ball, iris);
+      // The front of the ball sits just behind the deepest lid vertex.
+      eye.position.set(center.x, center.y, maxZ - radius - size.z * 0.15);
+      this.head.add(eye);
+    }
+  }
+
+  /** A dark ellipsoid behind the inner lips: what an open mouth shows instead of the mask's empty back. */
+  private addMouthBacking(): void {
+    const r = this.template.regions;
+    const { center, size } = this.bounds([...r.lips_inner_upper, ...r.lips_inner_lower]);
+    const outer = this.bounds(Array.from(r.lips_outer));
+    const mouth = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), new THREE.MeshStandardMaterial({ color: MOUTH_COLOR, roughness: 0.9 }));
+    mouth.name = 'mouth_backing';
+    const halfWidth = size.x * 0.5;
+    mouth.scale.set(halfWidth * 0.95, outer.size.y * 0.9, halfWidth * 0.8);
+    mouth.position.set(center.x, center.y - outer.size.y * 0.15, outer.minZ - halfWidth * 0.35);
+    this.head.add(mouth);
+  }
+
+  private bounds(indices: ArrayLike<number>): { center: THREE.Vector3; size: THREE.Vector3; maxZ: number; minZ: number } {
+    const box = new THREE.Box3();
+    const p = new THREE.Vector3();
+    const pos = this.template.positions;
+    for (let i = 0; i < indices.length; i++) box.expandByPoint(p.fromArray(pos, 3 * indices[i]));
+    return { center: box.getCenter(new THREE.Vector3()), size: box.getSize(new THREE.Vector3()), maxZ: box.max.z, minZ: box.min.z };
+  }
+}
+
+/**
+ * Per-vertex colours: skin, with the lips tinted. The lip surface is found by
+ * flooding the 1-ring graph from the inner-lip contour outward and stopping at
+ * the outer-lip contour, so it works for any template with those regions.
+ */
+function skinColors(t: FaceTemplate): Float32Array {
+  const skin = new THREE.Color(SKIN_COLOR);
+  const lip = new THREE.Color(LIP_COLOR);
+  const colors = new Float32Array(t.vertexCount * 3);
+  for (let v = 0; v < t.vertexCount; v++) skin.toArray(colors, 3 * v);
+  const outer = new Set(t.regions.lips_outer);
+  const isLip = new Uint8Array(t.vertexCount);
+  const queue = [...t.regions.lips_inner_upper, ...t.regions.lips_inner_lower];
+  for (const v of queue) isLip[v] = 1;
+  while (queue.length) {
+    const v = queue.pop()!;
+    if (outer.has(v)) continue;
+    for (let k = t.adjacency.offsets[v]; k < t.adjacency.offsets[v + 1]; k++) {
+      const w = t.adjacency.indices[k];
+      if (!isLip[w]) {
+        isLip[w] = 1;
+        queue.push(w);
+      }
+    }
+  }
+  for (let v = 0; v < t.vertexCount; v++) if (isLip[v]) lip.toArray(colors, 3 * v);
+  return colors;
+}

@@ -1,0 +1,232 @@
+/**
+ * The face template: a neutral mesh I (N x 3, Eq. 2 of the paper) with its
+ * triangles, UVs, 1-ring adjacency and named vertex regions.
+ *
+ * On disk a template is two files that TypeScript and Python both read:
+ *   template.json  header: ids, units, axes, region index lists, and where each
+ *                  array sits inside the binary file;
+ *   template.bin   little-endian arrays (float32 positions and UVs, uint32
+ *                  triangles and the CSR adjacency).
+ * Nothing here assumes a vertex count: a FLAME head (5023 vertices) converted
+ * with `scripts/import-template.ts` loads through the same code.
+ */
+import { buildAdjacency, type Adjacency } from './mesh-topology';
+
+export const TEMPLATE_FORMAT = 'talking-face-template';
+export const TEMPLATE_FORMAT_VERSION = 1;
+
+/** Region names every template must provide (the rig, the metrics and the viewer use them). */
+export const REQUIRED_REGIONS = [
+  'lips_inner_upper',
+  'lips_inner_lower',
+  'lips_outer',
+  'eye_left_upper',
+  'eye_left_lower',
+  'eye_right_upper',
+  'eye_right_lower',
+  'brows',
+  'upper_face',
+  'face_boundary',
+  'jaw',
+] as const;
+export type RegionName = (typeof REQUIRED_REGIONS)[number];
+export type Regions = Record<RegionName, Uint32Array> & Record<string, Uint32Array>;
+
+export interface FaceTemplate {
+  id: string;
+  /** Length unit of `positions` (the MediaPipe face is in centimetres). */
+  units: 'cm' | 'mm' | 'm';
+  vertexCount: number;
+  /** (N, 3) xyz, Y up, +Z toward the viewer, face centred near the origin. */
+  positions: Float32Array;
+  /** (N, 2) texture coordinates, or null when the source has none. */
+  uvs: Float32Array | null;
+  /** (T, 3) vertex indices, counter-clockwise seen from the front. */
+  triangles: Uint32Array;
+  /** 1-ring neighbours (no self loops) in CSR form. */
+  adjacency: Adjacency;
+  regions: Regions;
+  /** Free-form provenance (source package, licence). */
+  source: Record<string, string>;
+}
+
+type Dtype = 'float32' | 'uint32';
+interface BufferView {
+  dtype: Dtype;
+  byteOffset: number;
+  shape: number[];
+}
+
+export interface TemplateHeader {
+  format: typeof TEMPLATE_FORMAT;
+  version: number;
+  id: string;
+  units: FaceTemplate['units'];
+  axes: { up: '+y'; front: '+z'; right: '+x' };
+  vertexCount: number;
+  triangleCount: number;
+  binary: string;
+  binarySha256: string;
+  buffers: Record<'positions' | 'triangles' | 'adjacencyOffsets' | 'adjacencyIndices', BufferView> & {
+    uvs?: BufferView;
+  };
+  regions: Record<string, number[]>;
+  source: Record<string, string>;
+}
+
+export class TemplateFormatError extends Error {
+  override name = 'TemplateFormatError';
+}
+
+/** Serialise a template to the header + binary pair (the binary's hash goes in the header). */
+export async function encodeTemplate(
+  t: FaceTemplate,
+  binaryName: string,
+): Promise<{ header: TemplateHeader; binary: Uint8Array }> {
+  const parts: { name: string; data: Float32Array | Uint32Array; shape: number[] }[] = [
+    { name: 'positions', data: t.positions, shape: [t.vertexCount, 3] },
+    { name: 'triangles', data: t.triangles, shape: [t.triangles.length / 3, 3] },
+    { name: 'adjacencyOffsets', data: t.adjacency.offsets, shape: [t.vertexCount + 1] },
+    { name: 'adjacencyIndices', data: t.adjacency.indices, shape: [t.adjacency.indices.length] },
+  ];
+  if (t.uvs) parts.push({ name: 'uvs', data: t.uvs, shape: [t.vertexCount, 2] });
+
+  const total = parts.reduce((s, p) => s + p.data.byteLength, 0);
+  const binary = new Uint8Array(total);
+  const buffers: Record<string, BufferView> = {};
+  let offset = 0;
+  for (const p of parts) {
+    binary.set(new Uint8Array(p.data.buffer, p.data.byteOffset, p.data.byteLength), offset);
+    buffers[p.name] = {
+      dtype: p.data instanceof Float32Array ? 'float32' : 'uint32',
+      byteOffset: offset,
+      shape: p.shape,
+    };
+    offset += p.data.byteLength;
+  }
+  const regions: Record<string, number[]> = {};
+  for (const [name, idx] of Object.entries(t.regions)) regions[name] = Array.from(idx);
+
+  const header: TemplateHeader = {
+    format: TEMPLATE_FORMAT,
+    version: TEMPLATE_FORMAT_VERSION,
+    id: t.id,
+    units: t.units,
+    axes: { up: '+y', front: '+z', right: '+x' },
+    vertexCount: t.vertexCount,
+    triangleCount: t.triangles.length / 3,
+    binary: binaryName,
+    binarySha256: await sha256Hex(binary),
+    buffers: buffers as TemplateHeader['buffers'],
+    regions,
+    source: t.source,
+  };
+  return { header, binary };
+}
+
+/** Parse a header + binary pair, checking every count and index so a broken file fails here, not in a shader. */
+export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Promise<FaceTemplate> {
+  const h = header as TemplateHeader;
+  if (!h || h.format !== TEMPLATE_FORMAT) {
+    throw new TemplateFormatError(`not a face template: expected "format": "${TEMPLATE_FORMAT}"`);
+  }
+  if (h.version !== TEMPLATE_FORMAT_VERSION) {
+    throw new TemplateFormatError(`template format version ${h.version} is not supported (this build reads ${TEMPLATE_FORMAT_VERSION})`);
+  }
+  const digest = await sha256Hex(new Uint8Array(binary));
+  if (digest !== h.binarySha256) {
+    throw new TemplateFormatError(`template binary ${h.binary} is corrupt or does not belong to template "${h.id}" (sha256 mismatch)`);
+  }
+  const view = <T extends Float32Array | Uint32Array>(name: string, ctor: { new (b: ArrayBuffer, o: number, n: number): T }, required = true): T | null => {
+    const b = (h.buffers as Record<string, BufferView | undefined>)[name];
+    if (!b) {
+      if (required) throw new TemplateFormatError(`template "${h.id}" has no "${name}" buffer`);
+      return null;
+    }
+    const count = b.shape.reduce((a, c) => a * c, 1);
+    if (b.byteOffset % 4 !== 0 || b.byteOffset + count * 4 > binary.byteLength) {
+      throw new TemplateFormatError(`template buffer "${name}" lies outside ${h.binary}`);
+    }
+    return new ctor(binary.slice(b.byteOffset, b.byteOffset + count * 4), 0, count);
+  };
+  const positions = view('positions', Float32Array)!;
+  const triangles = view('triangles', Uint32Array)!;
+  const offsets = view('adjacencyOffsets', Uint32Array)!;
+  const indices = view('adjacencyIndices', Uint32Array)!;
+  const uvs = view('uvs', Float32Array, false);
+  const n = h.vertexCount;
+  if (positions.length !== n * 3 || offsets.length !== n + 1 || offsets[n] !== indices.length) {
+    throw new TemplateFormatError(`template "${h.id}": buffer sizes do not match vertexCount ${n}`);
+  }
+  checkIndices(triangles, n, 'triangles');
+  checkIndices(indices, n, 'adjacencyIndices');
+  const regions = {} as Regions;
+  for (const [name, list] of Object.entries(h.regions)) {
+    const idx = Uint32Array.from(list);
+    checkIndices(idx, n, `region ${name}`);
+    regions[name] = idx;
+  }
+  const missing = REQUIRED_REGIONS.filter((r) => !regions[r] || regions[r].length === 0);
+  if (missing.length) {
+    throw new TemplateFormatError(`template "${h.id}" lacks the regions ${missing.join(', ')} (see docs/templates.md)`);
+  }
+  return {
+    id: h.id,
+    units: h.units,
+    vertexCount: n,
+    positions,
+    uvs,
+    triangles,
+    adjacency: { offsets, indices },
+    regions,
+    source: h.source ?? {},
+  };
+}
+
+/** Fetch a template by the URL of its header; the binary is resolved next to it. */
+export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch): Promise<FaceTemplate> {
+  const res = await fetchFn(headerUrl);
+  if (!res.ok) throw new TemplateFormatError(`could not load the face template ${headerUrl}: HTTP ${res.status}`);
+  let header: TemplateHeader;
+  try {
+    header = await res.json();
+  } catch (e) {
+    throw new TemplateFormatError(`face template ${headerUrl} is not valid JSON: ${(e as Error).message}`);
+  }
+  const binUrl = new URL(header.binary, new URL(String(headerUrl), globalThis.location?.href ?? 'file:///'));
+  const bin = await fetchFn(binUrl);
+  if (!bin.ok) throw new TemplateFormatError(`could not load the template binary ${binUrl}: HTTP ${bin.status}`);
+  return decodeTemplate(header, await bin.arrayBuffer());
+}
+
+/** Build a template from a bare mesh plus region index lists (a user's OBJ/PLY and masks file). */
+export function templateFromMesh(
+  id: string,
+  units: FaceTemplate['units'],
+  positions: Float32Array,
+  triangles: Uint32Array,
+  uvs: Float32Array | null,
+  regions: Record<string, ArrayLike<number>>,
+  source: Record<string, string> = {},
+): FaceTemplate {
+  const n = positions.length / 3;
+  checkIndices(triangles, n, 'triangles');
+  const r = {} as Regions;
+  for (const [name, list] of Object.entries(regions)) {
+    const idx = Uint32Array.from(list);
+    checkIndices(idx, n, `region ${name}`);
+    r[name] = idx;
+  }
+  return { id, units, vertexCount: n, positions, uvs, triangles, adjacency: buildAdjacency(n, triangles), regions: r, source };
+}
+
+function checkIndices(a: Uint32Array, n: number, what: string): void {
+  for (let i = 0; i < a.length; i++) {
+    if (a[i] >= n) throw new TemplateFormatError(`${what}: index ${a[i]} is out of range for ${n} vertices`);
+  }
+}
+
+async function sha256Hex(bytes: Uint8Array): Promise<string> {
+  const digest = await crypto.subtle.digest('SHA-256', bytes as Uint8Array<ArrayBuffer>);
+  return Array.from(new Uint8Array(digest), (b) => b.toString(16).padStart(2, '0')).join('');
+}

@@ -1,0 +1,58 @@
+import { test, expect, imageStats } from './fixtures';
+
+test.describe('the face viewer', () => {
+  test.beforeEach(async ({ page }) => {
+    await page.goto('/');
+    await expect(page.locator('body')).toHaveAttribute('data-ready', 'true');
+  });
+
+  test('renders the shaded face filling a sensible part of the frame', async ({ page }) => {
+    const canvas = page.locator('#face-canvas');
+    const shot = await canvas.screenshot();
+    const s = await imageStats(page, shot);
+    // A shaded face, not a flat fill: many colours, and it covers 15-85% of the canvas, roughly centred.
+    expect(s.distinctColours).toBeGreaterThan(50);
+    expect(s.foregroundFraction).toBeGreaterThan(0.15);
+    expect(s.foregroundFraction).toBeLessThan(0.85);
+    const cx = (s.box.x0 + s.box.x1) / 2;
+    const cy = (s.box.y0 + s.box.y1) / 2;
+    expect(Math.abs(cx - 0.5)).toBeLessThan(0.15);
+    expect(Math.abs(cy - 0.5)).toBeLessThan(0.15);
+    await test.info().attach('viewer.png', { body: shot, contentType: 'image/png' });
+  });
+
+  test('finds the WebGPU adapter and says so in the status line', async ({ page }) => {
+    const gpu = await page.evaluate(() => {
+      const g = (globalThis as unknown as { talkingFace: { gpu: { available: boolean; info: { architecture: string } | null } } }).talkingFace.gpu;
+      return { available: g.available, architecture: g.info?.architecture };
+    });
+    expect(gpu.available).toBe(true);
+    expect(gpu.architecture).toBe('swiftshader');
+    await expect(page.locator('#status')).toContainText('WebGPU adapter: google swiftshader');
+  });
+
+  test('draws eyeballs and the inner-mouth backing', async ({ page }) => {
+    const names = await page.evaluate(() => {
+      const v = (globalThis as unknown as { talkingFace: { view: { head: { children: { name: string }[] } } } }).talkingFace.view;
+      return v.head.children.map((c) => c.name);
+    });
+    expect(names).toEqual(expect.arrayContaining(['face', 'eye_left', 'eye_right', 'mouth_backing']));
+  });
+
+  test('follows the window size', async ({ page }) => {
+    await page.setViewportSize({ width: 420, height: 800 });
+    await expect
+      .poll(() => page.evaluate(() => (document.getElementById('face-canvas') as HTMLCanvasElement).width))
+      .toBeLessThanOrEqual(420 * 2);
+    const s = await imageStats(page, await page.locator('#face-canvas').screenshot());
+    expect(s.foregroundFraction).toBeGreaterThan(0.1);
+  });
+});
+
+test('reports a missing template in the page instead of a blank screen', async ({ page, guard }) => {
+  guard.allowConsoleError(/404|could not load the face template/i);
+  await page.route('**/models/template/template.json', (route) => route.fulfill({ status: 404, body: 'gone' }));
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-ready', 'error');
+  await expect(page.locator('#status')).toContainText('could not load the face template');
+});
