@@ -47,6 +47,12 @@ ensure_chromium() {
   [ -x "$CHROMIUM_PATH" ] || { say "chromium is not at $CHROMIUM_PATH after installing; set CHROMIUM_PATH"; return 1; }
 }
 
+# The corpus's speech tools (festival, flite, espeak-ng, sox, recorded speech): the list lives in
+# training/src/talkingface/corpus/speech.py; its setup command installs what is missing. Needs the venv.
+ensure_corpus_tools() {
+  venv_python -m talkingface.corpus setup >&2
+}
+
 ensure_venv() {
   local py="${PYTHON:-python3}"
   "$py" -c 'import sys; assert sys.version_info >= (3, 11)' 2>/dev/null ||

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Set up everything (npm packages, Debian chromium, the Python venv) and run every suite:
+# Set up everything (npm packages, Debian chromium and speech tools, the Python venv) and run every suite:
 # pytest (training toolkit), TypeScript typecheck, Vitest (unit + parity), Playwright (browser).
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 ensure_node_modules
 ensure_chromium
 ensure_venv
+ensure_corpus_tools
 cd "$REPO_ROOT"
 failed=()
 passed=0

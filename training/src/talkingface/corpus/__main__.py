@@ -1,0 +1,108 @@
+"""Command line for the synthetic corpus.
+
+  scripts/py -m talkingface.corpus setup                     install the Debian speech tools (apt)
+  scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
+  scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
+  scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from .build import PRESETS, build_corpus
+from .speech import DEBIAN_PACKAGES, SpeechToolError
+
+
+def _progress():
+    start = time.time()
+    tty = sys.stderr.isatty()
+    last = [0.0]
+
+    def report(done: int, total: int, key: str) -> None:
+        now = time.time()
+        if not tty and now - last[0] < 5 and done != total:
+            return
+        last[0] = now
+        rate = done / max(now - start, 1e-6)
+        eta = (total - done) / max(rate, 1e-6)
+        bar = "#" * int(30 * done / total)
+        line = f"[{bar:<30}] {done}/{total} clips  {now - start:5.0f}s elapsed  ~{eta:4.0f}s left  ({key})"
+        print(("\r" + line) if tty else line, end="" if tty and done != total else "\n", file=sys.stderr, flush=True)
+    return report
+
+
+def cmd_setup(_args) -> int:
+    missing = [p for p in DEBIAN_PACKAGES if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
+    if not missing:
+        print("speech tools: all installed")
+        return 0
+    sudo = [] if os.geteuid() == 0 else ["sudo"]
+    print(f"installing: {' '.join(missing)}")
+    subprocess.run(sudo + ["apt-get", "update", "-qq"], check=True)
+    subprocess.run(sudo + ["apt-get", "install", "-y", "-qq", "--no-install-recommends", *missing], check=True,
+                   env={**os.environ, "DEBIAN_FRONTEND": "noninteractive"})
+    return 0
+
+
+def cmd_build(args) -> int:
+    cfg = replace(PRESETS[args.preset], seed=args.seed)
+    if args.subjects:
+        cfg = replace(cfg, subjects=tuple(args.subjects))
+    if args.sentences:
+        cfg = replace(cfg, sentences_per_subject=args.sentences)
+    for tool in ("festival", "flite", "espeak-ng", "sox"):
+        if shutil.which(tool) is None:
+            print(f"error: {tool} is missing; run `scripts/py -m talkingface.corpus setup` first", file=sys.stderr)
+            return 2
+    n = sum(cfg.subjects) * cfg.sentences_per_subject
+    print(f"building the {cfg.preset} corpus: {sum(cfg.subjects)} subjects x {cfg.sentences_per_subject} clips = {n} clips, "
+          f"seed {cfg.seed}, {args.workers} workers -> {args.out}", file=sys.stderr)
+    try:
+        meta = build_corpus(Path(args.out), cfg, workers=args.workers, template_path=args.template,
+                            overwrite=args.overwrite, progress=_progress())
+    except (FileExistsError, SpeechToolError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(f"done: {meta['clips']} clips, {meta['hours'] * 60:.1f} min of audio in {meta['build_seconds']:.0f} s -> {args.out}")
+    return 0
+
+
+def cmd_card(args) -> int:
+    from .card import write_card
+    path = write_card(Path(args.corpus), Path(args.out))
+    print(f"wrote {path}")
+    return 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.corpus", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    sub.add_parser("setup", help="install the Debian packages the corpus needs").set_defaults(fn=cmd_setup)
+    b = sub.add_parser("build", help="build a corpus")
+    b.add_argument("--preset", choices=sorted(PRESETS), default="small")
+    b.add_argument("--out", required=True, help="output folder (must be empty or a corpus to --overwrite)")
+    b.add_argument("--seed", type=int, default=0)
+    b.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    b.add_argument("--subjects", type=int, nargs=3, metavar=("TRAIN", "VAL", "TEST"), help="override the preset's subject counts")
+    b.add_argument("--sentences", type=int, help="override clips per subject")
+    b.add_argument("--template", type=Path, help="template.json of another face (default: the shipped MediaPipe face)")
+    b.add_argument("--overwrite", action="store_true", help="replace an existing corpus in --out")
+    b.set_defaults(fn=cmd_build)
+    c = sub.add_parser("card", help="write the dataset card (statistics and plots)")
+    c.add_argument("--corpus", required=True)
+    c.add_argument("--out", default="docs/corpus")
+    c.set_defaults(fn=cmd_card)
+    args = ap.parse_args(argv)
+    return args.fn(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

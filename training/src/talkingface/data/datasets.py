@@ -1,0 +1,205 @@
+"""One way to read talking-face data, wherever it came from.
+
+Three on-disk layouts open to the same `FaceDataset`:
+
+- our synthetic corpus (corpus/build.py): the community's VOCASET layout
+  (wav/, vertices_npy/, templates.pkl) plus meta.json, poses_npy/,
+  alignments/, splits.json and the template with its regions;
+- processed VOCASET as FaceFormer / CodeTalker write it (process_voca_data.py):
+  wav/SUBJECT_sentenceNN.wav, vertices_npy/SUBJECT_sentenceNN.npy (T at 60 fps,
+  5023*3, metres), templates.pkl (latin-1 pickle: subject -> (5023, 3));
+- processed Multiface as FaceDiffuser writes it: wav/SUBJECT_NN.wav,
+  vertices_npy/SUBJECT_NN.npy (T at 30 fps, 6172*3, millimetres), templates.pkl.
+
+The training code sees only `Clip`s: audio, per-frame vertices I + O, the
+subject's neutral face, an optional head pose and optional phone labels.
+Real datasets need a template file with the region masks (docs/templates.md)
+for their topology; pass it as `template=` or put it at ROOT/template/template.json.
+"""
+from __future__ import annotations
+
+import json
+import pickle
+import wave
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..template import Template, load_template
+
+CORPUS_FORMAT = "talking-face-corpus"
+
+# The VOCA split (FaceFormer vocaset/main.py, CodeTalker config/vocaset): subjects, then sentence ranges.
+VOCASET_SPLITS = {
+    "train": ("FaceTalk_170728_03272_TA FaceTalk_170904_00128_TA FaceTalk_170725_00137_TA FaceTalk_170915_00223_TA "
+              "FaceTalk_170811_03274_TA FaceTalk_170913_03279_TA FaceTalk_170904_03276_TA FaceTalk_170912_03278_TA", range(1, 41)),
+    "val": ("FaceTalk_170811_03275_TA FaceTalk_170908_03277_TA", range(21, 41)),
+    "test": ("FaceTalk_170809_00138_TA FaceTalk_170731_00024_TA", range(21, 41)),
+}
+# FaceDiffuser's Multiface split: sentence ranges over all subjects.
+MULTIFACE_SPLITS = {"train": range(1, 41), "val": range(41, 46), "test": range(46, 51)}
+
+
+class DatasetError(ValueError):
+    """The folder is not a dataset this toolkit reads, or is incomplete; the message says what is missing."""
+
+
+@dataclass
+class Clip:
+    key: str
+    subject: str
+    audio: np.ndarray                 # (S,) float32 mono in [-1, 1]
+    sample_rate: int
+    fps: float
+    vertices: np.ndarray              # (F, N, 3) float32, unposed I + O, dataset units
+    template: np.ndarray              # (N, 3) float32, this subject's neutral face
+    pose: np.ndarray | None = None    # (F, 6) [axis-angle (rad), translation (units)]; y = R x + t
+    phones: list[tuple[str, float, float]] | None = None  # (ARPAbet phone, start s, end s)
+    meta: dict = field(default_factory=dict)
+
+    @property
+    def num_frames(self) -> int:
+        return self.vertices.shape[0]
+
+
+@dataclass
+class FaceDataset:
+    root: Path
+    layout: str                      # "corpus", "vocaset" or "multiface"
+    template: Template               # topology and regions (vertices: a reference neutral face)
+    fps: float
+    mm_per_unit: float
+    splits: dict[str, list[str]]
+    subject_templates: dict[str, np.ndarray]
+    meta: dict = field(default_factory=dict)
+    _frame_step: int = 1
+
+    def keys(self, split: str) -> list[str]:
+        if split not in self.splits:
+            raise DatasetError(f"{self.root}: no split {split!r} (have {', '.join(self.splits)})")
+        return self.splits[split]
+
+    def subject_of(self, key: str) -> str:
+        if self.layout == "vocaset":
+            return key.split("_sentence")[0]
+        return key.rsplit("_", 1)[0]
+
+    def load(self, key: str) -> Clip:
+        subject = self.subject_of(key)
+        audio, sr = read_wav(self.root / "wav" / f"{key}.wav")
+        verts = np.load(self.root / "vertices_npy" / f"{key}.npy")[:: self._frame_step]
+        n = self.template.num_vertices
+        if verts.ndim != 2 or verts.shape[1] != n * 3:
+            raise DatasetError(f"{key}: vertices have shape {verts.shape}, expected (frames, {n * 3}) for template {self.template.id}")
+        clip = Clip(key, subject, audio, sr, self.fps, verts.reshape(-1, n, 3).astype(np.float32),
+                    self.subject_templates[subject].reshape(n, 3).astype(np.float32))
+        pose_path = self.root / "poses_npy" / f"{key}.npy"
+        if pose_path.exists():
+            clip.pose = np.load(pose_path).astype(np.float32)
+        align_path = self.root / "alignments" / f"{key}.json"
+        if align_path.exists():
+            a = json.loads(align_path.read_text())
+            clip.phones = [tuple(p) for p in a["phones"]]
+            clip.meta = {k: v for k, v in a.items() if k != "phones"}
+        return clip
+
+
+def open_dataset(root: str | Path, template: str | Path | None = None, masks: str | Path | None = None) -> FaceDataset:
+    """Open a dataset folder, recognising its layout. For real data, `template` is a template.json, or a
+    mesh (.obj/.ply, e.g. VOCASET's FLAME_sample.ply) with its `masks` file."""
+    root = Path(root)
+    if not root.is_dir():
+        raise DatasetError(f"dataset folder {root} does not exist")
+    for sub in ("wav", "vertices_npy"):
+        if not (root / sub).is_dir():
+            raise DatasetError(f"{root} has no {sub}/ folder: not a VOCASET-style dataset (wav/, vertices_npy/, templates.pkl)")
+    if (root / "meta.json").exists():
+        return _open_corpus(root)
+    keys = sorted(p.stem for p in (root / "vertices_npy").glob("*.npy"))
+    if not keys:
+        raise DatasetError(f"{root}/vertices_npy has no .npy files")
+    tpl = _real_template(root, template, masks)
+    subject_templates = _read_templates_pkl(root)
+    if any("_sentence" in k for k in keys):
+        splits = {}
+        for split, (subjects, sentences) in VOCASET_SPLITS.items():
+            subs = set(subjects.split())
+            splits[split] = [k for k in keys if k.split("_sentence")[0] in subs and int(k[-2:]) in sentences]
+        # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
+        return FaceDataset(root, "vocaset", tpl, 30.0, 1000.0, splits, subject_templates, _frame_step=2)
+    splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
+    return FaceDataset(root, "multiface", tpl, 30.0, 1.0, splits, subject_templates)
+
+
+def _open_corpus(root: Path) -> FaceDataset:
+    meta = json.loads((root / "meta.json").read_text())
+    if meta.get("format") != CORPUS_FORMAT:
+        raise DatasetError(f"{root}/meta.json is not a {CORPUS_FORMAT} file")
+    tpl = load_template(root / "template" / "template.json")
+    splits = json.loads((root / "splits.json").read_text())
+    mm = {"mm": 1.0, "cm": 10.0, "m": 1000.0}[meta["units"]]
+    return FaceDataset(root, "corpus", tpl, float(meta["fps"]), mm, splits, _read_templates_pkl(root), meta)
+
+
+def _real_template(root: Path, template: str | Path | None, masks: str | Path | None) -> Template:
+    path = Path(template) if template else root / "template" / "template.json"
+    if not path.exists():
+        raise DatasetError(
+            f"{root}: a real dataset needs its template with region masks: pass template=... (and masks=...) "
+            f"or put it at {path} (docs/templates.md)")
+    return load_template(path, masks)
+
+
+def _read_templates_pkl(root: Path) -> dict[str, np.ndarray]:
+    path = root / "templates.pkl"
+    if not path.exists():
+        raise DatasetError(f"{root} has no templates.pkl (subject -> neutral vertices)")
+    with open(path, "rb") as f:
+        # VOCASET's templates.pkl is a Python 2 pickle of numpy arrays (FaceFormer: encoding='latin1').
+        data = pickle.load(f, encoding="latin1")
+    return {k: np.asarray(v, dtype=np.float32) for k, v in data.items()}
+
+
+def read_wav(path: Path) -> tuple[np.ndarray, int]:
+    """16-bit PCM or 32-bit float WAV -> (mono float32 in [-1, 1], sample rate)."""
+    if not path.exists():
+        raise DatasetError(f"missing audio {path}")
+    with open(path, "rb") as f:
+        raw = f.read()
+    if raw[:4] != b"RIFF" or raw[8:12] != b"WAVE":
+        raise DatasetError(f"{path} is not a WAV file")
+    pos, fmt, data = 12, None, None
+    while pos + 8 <= len(raw):
+        cid, size = raw[pos : pos + 4], int.from_bytes(raw[pos + 4 : pos + 8], "little")
+        body = raw[pos + 8 : pos + 8 + size]
+        if cid == b"fmt ":
+            fmt = (int.from_bytes(body[0:2], "little"), int.from_bytes(body[2:4], "little"),
+                   int.from_bytes(body[4:8], "little"), int.from_bytes(body[14:16], "little"))
+        elif cid == b"data":
+            data = body
+        pos += 8 + size + (size & 1)
+    if fmt is None or data is None:
+        raise DatasetError(f"{path}: WAV without fmt or data chunk")
+    code, channels, sr, bits = fmt
+    if code == 1 and bits == 16:
+        x = np.frombuffer(data[: len(data) // 2 * 2], "<i2").astype(np.float32) / 32768.0
+    elif code == 3 and bits == 32:
+        x = np.frombuffer(data[: len(data) // 4 * 4], "<f4").astype(np.float32)
+    elif code == 0xFFFE and bits == 16:
+        x = np.frombuffer(data[: len(data) // 2 * 2], "<i2").astype(np.float32) / 32768.0
+    else:
+        raise DatasetError(f"{path}: WAV encoding {code} with {bits} bits is not supported (use 16-bit PCM or float32)")
+    if channels > 1:
+        x = x[: len(x) // channels * channels].reshape(-1, channels).mean(1)
+    return x, sr
+
+
+def write_wav(path: Path, audio: np.ndarray, sr: int) -> None:
+    """Mono float audio -> 16-bit PCM WAV (clipped to [-1, 1])."""
+    pcm = (np.clip(audio, -1.0, 1.0) * 32767.0).round().astype("<i2")
+    with wave.open(str(path), "wb") as w:
+        w.setnchannels(1)
+        w.setsampwidth(2)
+        w.setframerate(sr)
+        w.writeframes(pcm.tobytes())
