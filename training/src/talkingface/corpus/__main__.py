@@ -16,7 +16,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from .build import PRESETS, build_corpus
+from .build import PRESETS, ClipBuildError, build_corpus
 from .speech import DEBIAN_PACKAGES, SpeechToolError
 
 
@@ -67,7 +67,7 @@ def cmd_build(args) -> int:
     try:
         meta = build_corpus(Path(args.out), cfg, workers=args.workers, template_path=args.template,
                             overwrite=args.overwrite, progress=_progress())
-    except (FileExistsError, SpeechToolError) as e:
+    except (FileExistsError, SpeechToolError, ClipBuildError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print(f"done: {meta['clips']} clips, {meta['hours'] * 60:.1f} min of audio in {meta['build_seconds']:.0f} s -> {args.out}")

@@ -38,12 +38,16 @@ def flite_pronunciation(word: str) -> str:
 
 
 class Aligner:
-    """One pocketsphinx decoder (about 0.2 s to load); reuse it for many clips."""
+    """One pocketsphinx decoder (about 0.2 s to load). Its state carries over between utterances, so
+    where reproducibility matters, use a new Aligner per utterance."""
 
     def __init__(self):
         from pocketsphinx import Decoder  # imported here so the rest of the toolkit works without it
 
-        self.decoder = Decoder(samprate=ALIGN_RATE, lm=None, loglevel="FATAL")
+        # Batch cepstral mean normalisation: each utterance is normalised on its own. The default ("live")
+        # carries an estimate from one utterance to the next, so a clip's alignment would depend on which
+        # clips the same worker aligned before it, and the corpus on how clips fell to workers.
+        self.decoder = Decoder(samprate=ALIGN_RATE, lm=None, loglevel="FATAL", cmn="batch")
         arpa = [p for p in PHONES if p != SILENCE]
         for k, p in enumerate(arpa):  # one-phone pseudo-words for the fallback pass
             self.decoder.add_word(f"p_{p.lower()}", p, k == len(arpa) - 1)
@@ -92,7 +96,10 @@ class Aligner:
             phones = [("SIL" if s.word == "<sil>" else s.word[2:], s.start_frame * _FRAME + _FRAME, (s.end_frame + 1) * _FRAME + _FRAME)
                       for s in segs if s.word not in ("<s>", "</s>")]
             method = "one-pass-phones"
-        return _tidy([(p, a - _PAD, b - _PAD) for p, a, b in phones], duration), method
+        phones = _tidy([(p, a - _PAD, b - _PAD) for p, a, b in phones], duration)
+        if sum(p != SILENCE for p, _, _ in phones) < max(1, len(words) // 2):
+            raise AlignmentError(f"pocketsphinx found too few phones for {text!r} ({method})")
+        return phones, method
 
 
 def _tidy(phones, duration: float) -> list[tuple[str, float, float]]:

@@ -42,6 +42,7 @@ from .speech import SpeechToolError, Voice, all_voices, fit_to_duration, resampl
 from .phonemes import SILENCE
 
 CORPUS_VERSION = 1
+BUILDING_MARKER = ".building"
 
 
 @dataclass(frozen=True)
@@ -151,9 +152,10 @@ def _init_worker(template_path: str, subjects: list[Subject], cfg: CorpusConfig)
 
 
 def _aligner() -> Aligner:
-    if "aligner" not in _WORKER:
-        _WORKER["aligner"] = Aligner()
-    return _WORKER["aligner"]
+    """A fresh decoder for every clip (about 0.2 s): a reused pocketsphinx decoder carries state from one
+    utterance to the next, so alignments, and with them the corpus, would depend on which worker
+    happened to take which clips (test_same_seed_same_corpus caught this)."""
+    return Aligner()
 
 
 def _speech(spec: ClipSpec, sr: int) -> tuple[np.ndarray, list, dict]:
@@ -254,9 +256,17 @@ def neck_pivot(face: np.ndarray, template: Template) -> np.ndarray:
     return np.array([float(face[:, 0].mean()), y, float(face[:, 2].max()) - 0.6 * H])
 
 
+class ClipBuildError(RuntimeError):
+    pass
+
+
 def _worker_build(args):
     spec, out = args
-    return build_clip(spec, Path(out))
+    try:
+        return build_clip(spec, Path(out))
+    except Exception as e:  # name the clip: a bare traceback from a worker process does not
+        raise ClipBuildError(f"clip {spec.key} ({spec.voice and spec.voice['engine']}:{spec.voice and spec.voice['name']}, "
+                             f"{spec.recording or spec.text!r}): {type(e).__name__}: {e}") from e
 
 
 # ---- the whole corpus ------------------------------------------------------------------------
@@ -269,11 +279,14 @@ def build_corpus(out: Path, cfg: CorpusConfig, workers: int = 2, template_path: 
     if out.exists() and any(out.iterdir()):
         if not overwrite:
             raise FileExistsError(f"{out} already exists and is not empty: choose another --out or pass --overwrite")
-        if not (out / "meta.json").exists():
+        if not ((out / "meta.json").exists() or (out / BUILDING_MARKER).exists()):
             raise FileExistsError(f"{out} is not a corpus built by this tool; refusing to overwrite it")
         shutil.rmtree(out)
     template = load_template(template_path)
     subjects, specs = plan(cfg)
+    out.mkdir(parents=True, exist_ok=True)
+    # Marks an unfinished build, so an interrupted one can be replaced with --overwrite.
+    (out / BUILDING_MARKER).write_text("a corpus build started here and has not finished\n")
     for d in ("wav", "vertices_npy", "poses_npy", "alignments", "template"):
         (out / d).mkdir(parents=True, exist_ok=True)
     shutil.copy(template_path, out / "template" / "template.json")
@@ -307,4 +320,5 @@ def build_corpus(out: Path, cfg: CorpusConfig, workers: int = 2, template_path: 
     }
     (out / "meta.json").write_text(json.dumps(meta, indent=1))
     (out / "clips.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+    (out / BUILDING_MARKER).unlink()
     return meta

@@ -92,7 +92,9 @@ class Blink:
 def sample_blinks(duration: float, rng: np.random.Generator, style: SpeakingStyle = SpeakingStyle()) -> list[Blink]:
     """Blinks at uniform random intervals in style.blink_interval; ~120 ms each; one in five partial."""
     lo, hi = style.blink_interval
-    blinks, t = [], rng.uniform(0.3, hi)
+    # A clip starts at a random point of the blink cycle (a stationary renewal process), so short
+    # clips show the same rate as long ones.
+    blinks, t = [], rng.uniform(0.0, 1.0) * rng.uniform(lo, hi)
     while t < duration:
         amount = 1.0 if rng.random() > 0.2 else rng.uniform(0.5, 0.85)
         blinks.append(Blink(t, rng.uniform(0.1, 0.15), amount))

@@ -23,7 +23,7 @@ from .phonemes import P
 @dataclass(frozen=True)
 class RigScale:
     """How far each parameter moves at 1.0, as fractions of the inner mouth width W (about 45-50 mm)."""
-    jaw_degrees: float = 10.0      # mandible rotation about the hinge
+    jaw_degrees: float = 8.0       # mandible rotation about the hinge (open vowels: ~10-15 mm between the lips)
     lip_open_upper: float = 0.06   # upper lip raise
     lip_open_lower: float = 0.05   # lower lip drop, beyond the jaw
     round_narrow: float = 0.28     # fraction of the lip half-width removed by full rounding

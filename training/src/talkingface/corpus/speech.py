@@ -28,6 +28,8 @@ FLITE_VOICES = ("slt", "rms", "awb")  # kal/kal16 cut the final pause (platform.
 ESPEAK_ACCENTS = ("en-us", "en-gb-x-rp", "en-gb-x-gbclan", "en-gb-x-gbcwmd", "en-gb-scotland")
 ESPEAK_VARIANTS = ("f1", "f2", "f3", "f4", "f5", "m1", "m2", "m5", "m6", "klatt", "klatt2", "klatt3", "Henrique")
 
+ESPEAK_PAD = 0.2  # seconds of silence added before and after espeak-ng speech
+
 DEBIAN_PACKAGES = ("festival", "festvox-kallpc16k", "festvox-kdlpc16k", "festvox-us-slt-hts", "flite", "espeak-ng", "sox",
                    "asterisk-core-sounds-en-wav")
 
@@ -108,7 +110,10 @@ def synthesize(voice: Voice, text: str, sample_rate: int) -> tuple[np.ndarray, l
             require_tools("espeak-ng")
             wpm = int(round(160 * voice.rate))
             _run(["espeak-ng", "-v", voice.name, "-s", str(wpm), "-p", str(voice.pitch), "-w", str(wav), text])
-            phones = None
+            audio, sr = read_wav(wav)
+            # espeak-ng speaks from the first sample; a recording has silence around the speech.
+            pad = np.zeros(int(ESPEAK_PAD * sr), dtype=np.float32)
+            return resample(np.concatenate([pad, audio, pad]), sr, sample_rate), None
         else:
             raise SpeechToolError(f"voice engine {voice.engine!r} cannot synthesise")
         audio, sr = read_wav(wav)
