@@ -21,13 +21,6 @@ pytestmark = pytest.mark.skipif(not os.environ.get("CI") and (shutil.which("fest
                                 reason="speech tools missing: scripts/py -m talkingface.corpus setup")
 
 
-@pytest.fixture(scope="session")
-def corpus(tmp_path_factory):
-    out = tmp_path_factory.mktemp("corpus") / "small"
-    build_corpus(out, PRESETS["small"], workers=2)
-    return open_dataset(out)
-
-
 def all_clips(ds):
     return [ds.load(k) for split in ("train", "val", "test") for k in ds.keys(split)]
 

@@ -1,0 +1,42 @@
+"""One dataclass with every architectural choice; checkpoints and the export carry it."""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+from ..corpus.phonemes import PHONES
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    features: str = "LG"          # hierarchical feature: "G" global only, "L" local only, "LG" both summed (Sec. III-C)
+    decoder: str = "GAVA"         # "GAVA" neighbour-masked attention, "SA" unmasked self-attention, "MLP"
+    variant: str = "paper"        # "paper": masked attention only; "released": graph-conv Q/K/V + one full-attention layer per block
+    d_model: int = 64             # token size d
+    heads: int = 4                # attention heads (d_k = d_model / heads)
+    layers: int = 3               # attention layers (the paper's Fig. 7 reads the third)
+    ffn: int = 128                # feed-forward hidden size
+    content_classes: int = len(PHONES) + 1  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
+    content_channels: int = 128   # content encoder width
+    window: int = 16              # W: content frames per animation frame (paper: 16)
+    window_future: int = 6        # of which after the frame: the look-ahead streaming has to wait for
+    content_stride: int = 2       # content frames at feature_rate / stride (100 / 2 = 50 per second, like DeepSpeech)
+    pose_channels: int = 128      # pose encoder conv + LSTM width
+    global_hidden: int = 128      # hidden size of f_g's MLP
+    max_rotation: float = 0.5     # radians: tanh bound on predicted head rotation
+    max_translation_mm: float = 50.0  # bound on predicted head translation
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "ModelConfig":
+        names = {f.name for f in fields(cls)}
+        unknown = set(d) - names
+        if unknown:
+            raise ValueError(f"unknown model config keys {sorted(unknown)}: checkpoint from a newer version?")
+        return cls(**d)
+
+    @property
+    def name(self) -> str:
+        """The ablation row name of the paper's Table IV, e.g. "LG+GAVA"."""
+        return f"{self.features}+{self.decoder}"

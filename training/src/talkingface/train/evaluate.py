@@ -1,0 +1,81 @@
+"""Evaluate trained models on a dataset's test split with the paper's metrics.
+
+  scripts/py -m talkingface.train.evaluate --corpus data/corpus --checkpoint runs/default/final.pt --out docs/results/default.json
+
+Clips spoken by the recorded human voice are also reported on their own ("human"), apart from the
+synthetic voices ("synthetic").
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..corpus.pose import apply_pose as apply_pose_np
+from ..data.datasets import open_dataset
+from .data import prepare
+from .metrics import clip_metrics, eye_region, lip_region
+from .train import load_checkpoint
+
+
+def evaluate(model, ds, split: str = "test", progress=None) -> dict:
+    model.eval()
+    t = ds.template
+    regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
+    per_clip = []
+    keys = ds.keys(split)
+    for i, key in enumerate(keys):
+        c = prepare(ds, key, model.audio)
+        out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
+        pred_unposed, pred_pose = out["unposed"].numpy(), out["pose"].numpy()
+        gt_posed = apply_pose_np(c.vertices, c.pose)
+        m = clip_metrics(c.vertices, pred_unposed, gt_posed, out["vertices"].numpy(), c.template, c.pose, pred_pose, regions)
+        m.update(key=key, source=c.source, frames=c.num_frames)
+        per_clip.append(m)
+        if progress:
+            progress(i + 1, len(keys))
+    names = [k for k in per_clip[0] if k not in ("key", "source", "frames")]
+
+    def summary(rows):
+        if not rows:
+            return None
+        # Frame-weighted for the per-frame errors, per clip for the sequence statistics (as CodeTalker).
+        w = np.array([r["frames"] for r in rows], dtype=np.float64)
+        return {n: float(np.average([r[n] for r in rows], weights=w if n.startswith("E_") or n.startswith("pose_error") else None))
+                for n in names} | {"clips": len(rows)}
+    return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
+            "human": summary([r for r in per_clip if r["source"] == "human"]), "per_clip": per_clip}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.train.evaluate", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", required=True)
+    ap.add_argument("--checkpoint", required=True)
+    ap.add_argument("--split", default="test")
+    ap.add_argument("--out", help="write the results JSON here")
+    args = ap.parse_args(argv)
+    ds = open_dataset(args.corpus)
+    model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
+    t0 = time.time()
+    res = evaluate(model, ds, args.split)
+    res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
+                         "model_config": ck["model_config"]}
+    res["eval_seconds"] = time.time() - t0
+    a = res["all"]
+    print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
+          f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
+          + (f"  | human E_vl {res['human']['E_vl']:.3f} mm" if res["human"] else ""))
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(res, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

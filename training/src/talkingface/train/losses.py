@@ -1,0 +1,62 @@
+"""The training loss, Eq. 3-7: L = L_r + 10 L_v + 0.001 L_p + 0.005 L_e (plus the content encoder's phone loss)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+import torch.nn.functional as F
+
+from ..model.geometry import apply_pose
+
+
+@dataclass(frozen=True)
+class LossWeights:
+    velocity: float = 10.0   # lambda_1
+    pose: float = 0.001      # lambda_2
+    eye: float = 0.005       # lambda_3
+    content: float = 0.5     # auxiliary phone classification of the content encoder (our DeepSpeech stand-in)
+
+
+def reconstruction(y: torch.Tensor, y_hat: torch.Tensor) -> torch.Tensor:
+    """Eq. 4: mean over vertices (and frames) of the vertex-to-vertex L2 distance. (B, T, N, 3)."""
+    return (y - y_hat).norm(dim=-1).mean()
+
+
+def velocity(y: torch.Tensor, y_hat: torch.Tensor) -> torch.Tensor:
+    """Eq. 5: the same on frame-to-frame differences."""
+    return ((y[:, 1:] - y[:, :-1]) - (y_hat[:, 1:] - y_hat[:, :-1])).norm(dim=-1).mean()
+
+
+def pose_error(p: torch.Tensor, p_hat: torch.Tensor) -> torch.Tensor:
+    """Eq. 7: distance between pose parameters (axis-angle in degrees, translation in mm)."""
+    scale = torch.tensor([57.29578] * 3 + [1.0] * 3, device=p.device)
+    return ((p - p_hat) * scale).norm(dim=-1).mean()
+
+
+def eye_kl(offsets: torch.Tensor, offsets_hat: torch.Tensor, eye: torch.Tensor, eps: float = 0.1) -> torch.Tensor:
+    """Eq. 6: KL divergence between the ground-truth and predicted distributions of each eye vertex's
+    motion, pooled over all frames of the batch (not per clip: eyes move alike). Each vertex and axis is
+    a Gaussian: KL(N(m, s^2) || N(m^, s^^2)); eps (mm) floors the deviations so a still prediction
+    does not make the divergence explode at the start of training."""
+    g = offsets[..., eye, :].flatten(0, -3)                                   # (B*T, E, 3)
+    h = offsets_hat[..., eye, :].flatten(0, -3)
+    m, s = g.mean(0), g.std(0) + eps
+    mh, sh = h.mean(0), h.std(0) + eps
+    return (torch.log(sh / s) + (s ** 2 + (m - mh) ** 2) / (2 * sh ** 2) - 0.5).mean()
+
+
+def total_loss(out: dict, vertices: torch.Tensor, pose: torch.Tensor, template: torch.Tensor, content_labels: torch.Tensor,
+               eye: torch.Tensor, w: LossWeights = LossWeights()) -> tuple[torch.Tensor, dict]:
+    y = apply_pose(vertices, pose)                                            # ground truth posed, (B, T, N, 3)
+    y_hat = out["vertices"]
+    parts = {
+        "rec": reconstruction(y, y_hat),
+        "vel": velocity(y, y_hat),
+        "pose": pose_error(pose, out["pose"]),
+        "eye": eye_kl(vertices - template[:, None], out["offsets"], eye),
+    }
+    logits = out["content_logits"]
+    kc = min(logits.shape[1], content_labels.shape[1])
+    parts["content"] = F.cross_entropy(logits[:, :kc].flatten(0, 1), content_labels[:, :kc].flatten(), ignore_index=-100)
+    loss = parts["rec"] + w.velocity * parts["vel"] + w.pose * parts["pose"] + w.eye * parts["eye"] + w.content * parts["content"]
+    return loss, {k: float(v.detach()) for k, v in parts.items()}

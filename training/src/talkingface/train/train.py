@@ -1,0 +1,183 @@
+"""Train the model on any dataset `open_dataset` reads.
+
+  scripts/py -m talkingface.train.train --corpus data/corpus --out runs/default --minutes 55
+  scripts/py -m talkingface.train.train --corpus data/corpus --out runs/lg-mlp --decoder MLP --steps 800
+  torchrun --nproc-per-node 2 -m talkingface.train.train ...      (DDP; gloo on the CPU, nccl on GPUs)
+
+Checkpoints (OUT/checkpoint.pt, and OUT/final.pt at the end) carry the model and audio configs,
+the training arguments and the step, so `--resume` continues exactly and evaluation/export need
+nothing else. Nothing in OUT is deleted.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from dataclasses import asdict, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.distributed as dist
+
+from ..data.datasets import open_dataset
+from ..features import AudioConfig
+from ..model.config import ModelConfig
+from ..model.gava import TalkingFace, count_parameters
+from .data import mel_statistics, prepare, sample_batch
+from .losses import LossWeights, total_loss
+
+
+def eye_indices(template) -> torch.Tensor:
+    r = template.regions
+    return torch.from_numpy(np.unique(np.concatenate([r[f"eye_{s}_{p}"] for s in ("left", "right") for p in ("upper", "lower")])))
+
+
+def load_checkpoint(path: Path, template=None):
+    """-> (model, checkpoint dict). `template` defaults to the dataset template recorded in the checkpoint."""
+    ck = torch.load(path, map_location="cpu", weights_only=False)
+    cfg = ModelConfig.from_dict(ck["model_config"])
+    audio = AudioConfig(**ck["audio_config"])
+    if template is None:
+        from ..template import load_template
+        template = load_template(ck["template_path"])
+    if template.id != ck["template_id"]:
+        raise ValueError(f"{path} was trained on template {ck['template_id']}, not {template.id}")
+    model = TalkingFace(cfg, template, audio)
+    model.load_state_dict(ck["model"])
+    return model, ck
+
+
+def parse_args(argv=None) -> argparse.Namespace:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.train.train", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", required=True, help="dataset folder (our corpus, processed VOCASET or Multiface)")
+    ap.add_argument("--template", help="template for a real dataset (template.json, or a mesh with --masks)")
+    ap.add_argument("--masks", help="region masks for a mesh template")
+    ap.add_argument("--out", required=True, help="run folder for checkpoints and logs")
+    ap.add_argument("--features", default="LG", choices=["G", "L", "LG"])
+    ap.add_argument("--decoder", default="GAVA", choices=["GAVA", "SA", "MLP"])
+    ap.add_argument("--variant", default="paper", choices=["paper", "released"])
+    ap.add_argument("--minutes", type=float, help="stop after this much training time")
+    ap.add_argument("--steps", type=int, help="stop after this many steps (one of --minutes / --steps)")
+    ap.add_argument("--batch-clips", type=int, default=8, help="clips per step (per process under DDP)")
+    ap.add_argument("--frames", type=int, default=8, help="consecutive frames per clip crop")
+    ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--threads", type=int, help="torch CPU threads per process (default: cores / processes)")
+    ap.add_argument("--checkpoint-every", type=int, default=200)
+    ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    args = ap.parse_args(argv)
+    if (args.minutes is None) == (args.steps is None):
+        ap.error("give exactly one of --minutes and --steps")
+    return args
+
+
+def main(argv=None) -> int:
+    args = parse_args(argv)
+    distributed = int(os.environ.get("WORLD_SIZE", "1")) > 1
+    rank = 0
+    if distributed:
+        dist.init_process_group("gloo" if not torch.cuda.is_available() else "nccl")
+        rank = dist.get_rank()
+    world = dist.get_world_size() if distributed else 1
+    torch.set_num_threads(args.threads or max(1, (os.cpu_count() or 1) // world))
+    log = (lambda *a: print(*a, file=sys.stderr, flush=True)) if rank == 0 else (lambda *a: None)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+
+    ds = open_dataset(args.corpus, args.template, args.masks)
+    audio = AudioConfig(fps=int(ds.fps))
+    cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant)
+    t0 = time.time()
+    clips = [prepare(ds, k, audio) for k in ds.keys("train")]
+    log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
+        f"prepared in {time.time() - t0:.0f} s; {world} process(es)")
+
+    torch.manual_seed(args.seed)
+    model = TalkingFace(cfg, ds.template, audio)
+    mean, std = mel_statistics(clips)
+    for norm in (model.content.norm, model.pose_encoder.norm):
+        norm.mean.copy_(torch.from_numpy(mean))
+        norm.std.copy_(torch.from_numpy(std))
+    opt = torch.optim.Adam(model.parameters(), lr=args.lr)
+    step, trained_seconds = 0, 0.0
+    ck_path = out / "checkpoint.pt"
+    if args.resume:
+        if not ck_path.exists():
+            raise SystemExit(f"--resume: {ck_path} does not exist")
+        ck = torch.load(ck_path, map_location="cpu", weights_only=False)
+        if ck["model_config"] != cfg.to_dict():
+            raise SystemExit(f"--resume: {ck_path} is a {ck['model_config']} model, not {cfg.to_dict()}")
+        model.load_state_dict(ck["model"])
+        opt.load_state_dict(ck["optimizer"])
+        step, trained_seconds = ck["step"], ck["trained_seconds"]
+        log(f"resumed at step {step} ({trained_seconds / 60:.1f} min trained)")
+    net = torch.nn.parallel.DistributedDataParallel(model) if distributed else model
+    log(f"{count_parameters(model):,} parameters ({count_parameters(model) * 4 / 1e6:.2f} MB float32)")
+
+    eye = eye_indices(ds.template)
+    rng = np.random.default_rng(args.seed * 1000 + rank + step)
+    budget_steps = args.steps
+    total_est = budget_steps or 0
+    weights = LossWeights()
+
+    def save(path: Path) -> None:
+        if rank != 0:
+            return
+        torch.save({"model": model.state_dict(), "optimizer": opt.state_dict(), "step": step,
+                    "trained_seconds": trained_seconds, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(),
+                    "template_id": ds.template.id, "template_path": str(Path(args.corpus) / "template" / "template.json")
+                    if args.template is None else args.template, "args": vars(args), "world_size": world}, path.with_suffix(".tmp"))
+        os.replace(path.with_suffix(".tmp"), path)
+
+    history = []
+    start = time.time() - trained_seconds
+    model.train()
+    while True:
+        trained_seconds = time.time() - start
+        done = (budget_steps is not None and step >= budget_steps) or (args.minutes is not None and trained_seconds >= 60 * args.minutes)
+        if distributed:  # every process stops at the same step
+            flag = torch.tensor([1.0 if done else 0.0])
+            dist.all_reduce(flag, op=dist.ReduceOp.MAX)
+            done = flag.item() > 0
+        if done:
+            break
+        # Cosine decay over the budget (steps, or time when the budget is minutes).
+        progress = step / budget_steps if budget_steps else trained_seconds / (60 * args.minutes)
+        for g in opt.param_groups:
+            g["lr"] = args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
+        b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio)
+        out_ = net(b.mel, b.mel_index, b.template)
+        loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, weights)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        opt.step()
+        step += 1
+        history.append(parts)
+        if step % 20 == 0 and rank == 0:
+            avg = {k: np.mean([h[k] for h in history[-20:]]) for k in parts}
+            rate = step / max(time.time() - start, 1e-9)
+            left = ((budget_steps - step) / rate) if budget_steps else (60 * args.minutes - trained_seconds)
+            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
+                f"phones {avg['content']:.3f}  lr {opt.param_groups[0]['lr']:.1e}  {rate:.2f} steps/s  ~{left / 60:.1f} min left")
+        if step % args.checkpoint_every == 0:
+            save(ck_path)
+    save(ck_path)
+    save(out / "final.pt")
+    if rank == 0:
+        (out / "train_log.json").write_text(json.dumps({"steps": step, "minutes": trained_seconds / 60, "world_size": world,
+                                                         "model_config": cfg.to_dict(), "args": vars(args),
+                                                         "last_100": {k: float(np.mean([h[k] for h in history[-100:]])) for k in history[0]} if history else {}},
+                                                        indent=1))
+        log(f"done: {step} steps in {trained_seconds / 60:.1f} min -> {out / 'final.pt'}")
+    if distributed:
+        dist.destroy_process_group()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,39 @@
+"""Training, resuming, evaluating and distributed training on the small corpus (a few steps each)."""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import torch
+
+from talkingface.train import evaluate, train
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+
+def test_train_resume_and_evaluate(corpus, tmp_path):
+    out = tmp_path / "run"
+    common = ["--corpus", str(corpus.root), "--out", str(out), "--batch-clips", "2", "--frames", "4", "--checkpoint-every", "2"]
+    assert train.main(common + ["--steps", "3"]) == 0
+    ck = torch.load(out / "checkpoint.pt", weights_only=False)
+    assert ck["step"] == 3 and ck["model_config"]["decoder"] == "GAVA" and ck["template_id"] == corpus.template.id
+    assert train.main(common + ["--steps", "5", "--resume"]) == 0
+    ck = torch.load(out / "final.pt", weights_only=False)
+    assert ck["step"] == 5
+    model, _ = train.load_checkpoint(out / "final.pt", corpus.template)
+    res = evaluate.evaluate(model, corpus, "test")
+    for key in ("E_vl", "E_ve", "FDD", "AFDD", "pose_error_deg", "pose_jitter_deg"):
+        assert key in res["all"]
+    assert res["all"]["clips"] == len(corpus.keys("test"))
+
+
+def test_two_process_ddp_with_gloo(corpus, tmp_path):
+    out = tmp_path / "ddp"
+    env = {**os.environ, "PYTHONPATH": SRC, "OMP_NUM_THREADS": "1"}
+    cmd = [sys.executable, "-m", "torch.distributed.run", "--nproc-per-node", "2", "--master-port", "29517",
+           "-m", "talkingface.train.train", "--corpus", str(corpus.root), "--out", str(out), "--steps", "2",
+           "--batch-clips", "2", "--frames", "4", "--threads", "1"]
+    res = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    ck = torch.load(out / "final.pt", weights_only=False)
+    assert ck["world_size"] == 2 and ck["step"] == 2
