@@ -1,4 +1,4 @@
-import { defineConfig, type Plugin } from 'vite';
+import { defineConfig, defaultClientConditions, type Plugin } from 'vite';
 import { createReadStream, existsSync, statSync, cpSync } from 'node:fs';
 import { resolve, normalize, sep, extname } from 'node:path';
 
@@ -12,20 +12,31 @@ const isolationHeaders = {
 };
 
 const MODELS_DIR = resolve(import.meta.dirname, 'models');
+// onnxruntime-web's runtime (wasm + its Emscripten glue), served as plain files at /ort/ and loaded through
+// ort.env.wasm.wasmPaths: its thread workers then import that glue, never a bundled chunk of the app.
+const ORT_DIST = resolve(import.meta.dirname, 'node_modules/onnxruntime-web/dist');
+const ORT_FILES = ['ort-wasm-simd-threaded.jsep.mjs', 'ort-wasm-simd-threaded.jsep.wasm', 'ort-wasm-simd-threaded.mjs', 'ort-wasm-simd-threaded.wasm'];
 const MIME: Record<string, string> = {
   '.json': 'application/json',
   '.onnx': 'application/octet-stream',
   '.bin': 'application/octet-stream',
   '.safetensors': 'application/octet-stream',
+  '.mjs': 'text/javascript',
+  '.wasm': 'application/wasm',
 };
 
 /** Serve models/ at /models/ in dev and preview, and copy it into the build: the exported artefacts live in one place. */
 function modelsDir(): Plugin {
   const middleware = (req: { url?: string }, res: import('node:http').ServerResponse, next: () => void) => {
     const url = decodeURIComponent((req.url ?? '').split('?')[0]);
-    if (!url.startsWith('/models/')) return next();
-    const file = normalize(resolve(MODELS_DIR, '.' + url.slice('/models'.length)));
-    if (!file.startsWith(MODELS_DIR + sep) || !existsSync(file) || !statSync(file).isFile()) {
+    let file: string;
+    if (url.startsWith('/models/')) {
+      file = normalize(resolve(MODELS_DIR, '.' + url.slice('/models'.length)));
+      if (!file.startsWith(MODELS_DIR + sep)) file = '';
+    } else if (url.startsWith('/ort/') && ORT_FILES.includes(url.slice('/ort/'.length))) {
+      file = resolve(ORT_DIST, url.slice('/ort/'.length));
+    } else return next();
+    if (!file || !existsSync(file) || !statSync(file).isFile()) {
       res.statusCode = 404;
       res.end(`not found: ${url}`);
       return;
@@ -48,6 +59,7 @@ function modelsDir(): Plugin {
     },
     closeBundle() {
       cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true });
+      for (const f of ORT_FILES) cpSync(resolve(ORT_DIST, f), resolve(outDir, 'ort', f));
     },
   };
 }
@@ -56,6 +68,17 @@ export default defineConfig({
   plugins: [modelsDir()],
   server: { headers: isolationHeaders, port: 5173, strictPort: false },
   preview: { headers: isolationHeaders, port: 4173, strictPort: false },
-  build: { target: 'es2022', sourcemap: true, chunkSizeWarningLimit: 1024 },
+  build: {
+    target: 'es2022',
+    sourcemap: true,
+    chunkSizeWarningLimit: 1024,
+    // dev/parity.html is a test page for the engine's parity checks (tests/e2e/engine-parity.spec.ts).
+    rolldownOptions: {
+      input: { main: resolve(import.meta.dirname, 'index.html'), parity: resolve(import.meta.dirname, 'dev/parity.html') },
+    },
+  },
   optimizeDeps: { exclude: ['onnxruntime-web'] },
+  // The "extern wasm" build of onnxruntime-web (see ORT_FILES above) instead of the one with the wasm glue inlined:
+  // inlined, its thread workers import the bundle's chunk, which here imports a page entry ("document is not defined").
+  resolve: { conditions: ['onnxruntime-web-use-extern-wasm', ...defaultClientConditions] },
 });

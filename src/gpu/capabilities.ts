@@ -46,3 +46,26 @@ async function probe(): Promise<WebGPUSupport> {
     info,
   };
 }
+
+let sharedDevice: Promise<GPUDevice> | null = null;
+
+/**
+ * The page's one GPUDevice (an adapter can create only one), shared by every decoder. After the device
+ * is lost, the next call probes for a new adapter and device.
+ */
+export function requestSharedDevice(): Promise<GPUDevice> {
+  sharedDevice ??= (async () => {
+    const support = await detectWebGPU();
+    if (!support.adapter) throw new Error(support.description);
+    const device = await support.adapter.requestDevice({ label: 'talkingFace.device' });
+    device.lost.then(() => {
+      sharedDevice = null;
+      cached = null;
+    });
+    return device;
+  })();
+  sharedDevice.catch(() => {
+    sharedDevice = null;
+  });
+  return sharedDevice;
+}

@@ -126,8 +126,9 @@ def test_losses_vanish_on_a_perfect_prediction():
     y = apply_pose(v, pose)
     out = {"vertices": y, "pose": pose, "offsets": v - tpl[:, None], "content_logits": torch.zeros(2, 4, 41)}
     _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), torch.arange(5))
-    assert parts["rec"] < 1e-6 and parts["vel"] < 1e-6 and parts["pose"] < 1e-6 and abs(parts["eye"]) < 1e-6
-    out["vertices"] = y + torch.tensor([1.0, 0, 0])
+    assert parts["rec"] < 1e-6 and parts["rec_unposed"] < 1e-6 and parts["vel"] < 1e-6 and parts["pose"] < 1e-6
+    assert abs(parts["eye"]) < 1e-6
+    out["vertices"] = y + torch.tensor([1.0, 0, 0])  # a posed-only error leaves the unposed term at zero
     _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), torch.arange(5))
     assert parts["rec"] == pytest.approx(1.0, abs=1e-5) and parts["vel"] < 1e-6
 

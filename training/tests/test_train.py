@@ -37,3 +37,16 @@ def test_two_process_ddp_with_gloo(corpus, tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     ck = torch.load(out / "final.pt", weights_only=False)
     assert ck["world_size"] == 2 and ck["step"] == 2
+
+
+def test_ablation_driver_writes_the_table(corpus, tmp_path):
+    import json
+    from talkingface.train import ablation
+    out = tmp_path / "results"
+    ablation.main(["--corpus", str(corpus.root), "--steps", "1", "--rows", "G+MLP", "LG+GAVA", "--runs", str(tmp_path / "runs"),
+                   "--out", str(out), "--batch-clips", "2", "--frames", "4"])
+    table = json.loads((out / "ablation.json").read_text())
+    for row in ("G+MLP", "LG+GAVA"):
+        assert set(("E_vl", "E_ve", "FDD", "AFDD")) <= set(table[row])
+        assert all(isinstance(table[row][k], float) for k in ("E_vl", "E_ve", "FDD", "AFDD"))
+    assert "cannot be judged yet" in (out / "ablation.md").read_text()

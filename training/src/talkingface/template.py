@@ -271,3 +271,26 @@ def _ply_binary(data: bytes, pos: int, elements) -> dict[str, list[dict]]:
             rows.append(row)
         out[name] = rows
     return out
+
+
+def subdivide(t: Template, new_id: str | None = None) -> Template:
+    """Midpoint subdivision: every edge gets a vertex, every triangle becomes four. A new vertex joins a
+    region when both ends of its edge are in it. (468 -> 1,788 vertices for the MediaPipe face.)"""
+    tri = t.triangles
+    edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    uniq, inverse = np.unique(edges, axis=0, return_inverse=True)
+    n = t.num_vertices
+    mid = n + inverse.reshape(3, -1).T                                          # (T, 3) midpoints of edges 01, 12, 20
+    verts = np.concatenate([t.vertices, 0.5 * (t.vertices[uniq[:, 0]] + t.vertices[uniq[:, 1]])]).astype(np.float32)
+    a, b, c = tri.T
+    m01, m12, m20 = mid.T
+    new_tri = np.concatenate([np.stack([a, m01, m20], 1), np.stack([m01, b, m12], 1), np.stack([m20, m12, c], 1), np.stack([m01, m12, m20], 1)])
+    uvs = None
+    if t.uvs is not None:
+        uvs = np.concatenate([t.uvs, 0.5 * (t.uvs[uniq[:, 0]] + t.uvs[uniq[:, 1]])]).astype(np.float32)
+    regions = {}
+    for name, idx in t.regions.items():
+        member = np.zeros(n, dtype=bool)
+        member[idx] = True
+        regions[name] = np.concatenate([idx, n + np.flatnonzero(member[uniq[:, 0]] & member[uniq[:, 1]])])
+    return template_from_mesh(new_id or f"{t.id}-subdivided", t.units, verts, new_tri, regions, uvs, {**t.source, "subdivided": "midpoint"})

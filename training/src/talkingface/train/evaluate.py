@@ -72,9 +72,38 @@ def main(argv=None) -> int:
           f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
           + (f"  | human E_vl {res['human']['E_vl']:.3f} mm" if res["human"] else ""))
     if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text(json.dumps(res, indent=1))
+        out = Path(args.out)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(res, indent=1))
+        out.with_suffix(".md").write_text(markdown(res, args, ck))
     return 0
+
+
+def markdown(res: dict, args, ck: dict) -> str:
+    cfg = ck["model_config"]
+    rows = []
+    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+        r = res[name]
+        if r:
+            rows.append(f"| {label} | {r['clips']} | {r['E_vl']:.3f} | {r['E_ve']:.3f} | {r['E_vl_posed']:.3f} | {r['FDD']:.4f} | "
+                        f"{r['AFDD']:.4f} | {r['pose_error_deg']:.2f} | {r['pose_jitter_deg']:.3f} ({r['pose_jitter_gt_deg']:.3f}) |")
+    return "\n".join([
+        f"# {cfg['features']}+{cfg['decoder']} on the {args.split} split",
+        "",
+        f"Checkpoint `{args.checkpoint}`: {ck['step']} steps, {ck['trained_seconds'] / 60:.1f} min of training "
+        f"({ck.get('world_size', 1)} process(es)). Made by",
+        f"`scripts/py -m talkingface.train.evaluate --corpus {args.corpus} --checkpoint {args.checkpoint} --split {args.split} --out {args.out}`.",
+        "",
+        "Errors in mm. E_vl / E_ve: mean over frames of the largest lip / eye vertex error on the unposed face (Eq. 8);",
+        "E_vl posed: the same with the predicted head pose applied. FDD (Eq. 9, signed) and AFDD (Eq. 10) on the upper face.",
+        "Pose error: angle between true and predicted head rotation; jitter: mean second difference of the predicted",
+        "rotation per frame (ground truth's in brackets).",
+        "",
+        "| clips | n | E_vl | E_ve | E_vl posed | FDD | AFDD | pose error (deg) | jitter (deg) |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        *rows,
+        "",
+    ])
 
 
 if __name__ == "__main__":

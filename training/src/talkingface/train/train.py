@@ -69,6 +69,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--threads", type=int, help="torch CPU threads per process (default: cores / processes)")
     ap.add_argument("--checkpoint-every", type=int, default=200)
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    ap.add_argument("--paper-loss", action="store_true", help="the paper's Eq. 3 exactly (no unposed reconstruction term; see losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
         ap.error("give exactly one of --minutes and --steps")
@@ -122,7 +123,7 @@ def main(argv=None) -> int:
     rng = np.random.default_rng(args.seed * 1000 + rank + step)
     budget_steps = args.steps
     total_est = budget_steps or 0
-    weights = LossWeights()
+    weights = LossWeights(unposed=0.0) if args.paper_loss else LossWeights()
 
     def save(path: Path) -> None:
         if rank != 0:
@@ -162,7 +163,7 @@ def main(argv=None) -> int:
             avg = {k: np.mean([h[k] for h in history[-20:]]) for k in parts}
             rate = step / max(time.time() - start, 1e-9)
             left = ((budget_steps - step) / rate) if budget_steps else (60 * args.minutes - trained_seconds)
-            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
+            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  unposed {avg['rec_unposed']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
                 f"phones {avg['content']:.3f}  lr {opt.param_groups[0]['lr']:.1e}  {rate:.2f} steps/s  ~{left / 60:.1f} min left")
         if step % args.checkpoint_every == 0:
             save(ck_path)

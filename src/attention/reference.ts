@@ -1,0 +1,223 @@
+/**
+ * The GAVA decoder on the CPU, in plain TypeScript: the readable reference that the WGSL kernel
+ * is tested against, and the fallback where WebGPU is missing. Same layers as
+ * training/src/talkingface/model (pre-norm transformer; paper Eq. 1 with the augmented adjacency):
+ *
+ *   x = x + Wo · Attn(LN1 x)      vertex j attends to itself and its 1-ring; the pose token to all
+ *   x = x + W2 · gelu(W1 · LN2 x)
+ *   then LN, displacement head (d -> 3, mm) per vertex, pose head (d -> 6) on the pose token.
+ */
+import { f32, type Tensor } from '../model/safetensors';
+import type { ModelConstants } from '../model/manifest';
+import type { Adjacency } from '../template/mesh-topology';
+
+const LN_EPS = 1e-5;
+
+export interface LayerWeights {
+  ln1g: Float32Array; ln1b: Float32Array;
+  qkvW: Float32Array; qkvB: Float32Array; // (3d x d), (3d)
+  outW: Float32Array; outB: Float32Array; // (d x d), (d)
+  ln2g: Float32Array; ln2b: Float32Array;
+  ffn1W: Float32Array; ffn1B: Float32Array; // (ffn x d)
+  ffn2W: Float32Array; ffn2B: Float32Array; // (d x ffn)
+}
+
+export interface DecoderWeights {
+  layers: LayerWeights[];
+  lnG: Float32Array; lnB: Float32Array;
+  dispW: Float32Array; dispB: Float32Array; // (3 x d)
+  poseW: Float32Array; poseB: Float32Array; // (6 x d)
+}
+
+/** Pick the decoder's tensors out of gava.safetensors, checking every shape against the model constants. */
+export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants): DecoderWeights {
+  const d = m.d_model;
+  const layers: LayerWeights[] = [];
+  for (let i = 0; i < m.layers; i++) {
+    const p = `decoder.blocks.${i}.`;
+    layers.push({
+      ln1g: f32(t, p + 'ln1.weight', [d]), ln1b: f32(t, p + 'ln1.bias', [d]),
+      qkvW: f32(t, p + 'attn.qkv.weight', [3 * d, d]), qkvB: f32(t, p + 'attn.qkv.bias', [3 * d]),
+      outW: f32(t, p + 'attn.out.weight', [d, d]), outB: f32(t, p + 'attn.out.bias', [d]),
+      ln2g: f32(t, p + 'ln2.weight', [d]), ln2b: f32(t, p + 'ln2.bias', [d]),
+      ffn1W: f32(t, p + 'ffn.0.weight', [m.ffn, d]), ffn1B: f32(t, p + 'ffn.0.bias', [m.ffn]),
+      ffn2W: f32(t, p + 'ffn.2.weight', [d, m.ffn]), ffn2B: f32(t, p + 'ffn.2.bias', [d]),
+    });
+  }
+  return {
+    layers,
+    lnG: f32(t, 'decoder.ln.weight', [d]), lnB: f32(t, 'decoder.ln.bias', [d]),
+    dispW: f32(t, 'displacement_head.weight', [3, d]), dispB: f32(t, 'displacement_head.bias', [3]),
+    poseW: f32(t, 'pose_head.weight', [6, d]), poseB: f32(t, 'pose_head.bias', [6]),
+  };
+}
+
+/** erf by Abramowitz & Stegun 7.1.26 (|error| < 1.5e-7); the WGSL kernel uses the same formula. */
+export function erf(x: number): number {
+  const s = Math.sign(x);
+  const a = Math.abs(x);
+  const t = 1 / (1 + 0.3275911 * a);
+  const y = 1 - ((((1.061405429 * t - 1.453152027) * t + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t * Math.exp(-a * a);
+  return s * y;
+}
+
+/** GELU, exact form (PyTorch's nn.GELU default): x/2 (1 + erf(x / sqrt 2)). */
+export function gelu(x: number): number {
+  return 0.5 * x * (1 + erf(x * Math.SQRT1_2));
+}
+
+function layerNorm(x: Float32Array, off: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, outOff: number): void {
+  let mean = 0;
+  for (let i = 0; i < d; i++) mean += x[off + i];
+  mean /= d;
+  let v = 0;
+  for (let i = 0; i < d; i++) v += (x[off + i] - mean) ** 2;
+  const inv = 1 / Math.sqrt(v / d + LN_EPS);
+  for (let i = 0; i < d; i++) out[outOff + i] = (x[off + i] - mean) * inv * g[i] + b[i];
+}
+
+/** out[o] = W[o, :] . x + b[o] for a (rows x cols) row-major W. */
+function linear(W: Float32Array, b: Float32Array, rows: number, cols: number, x: Float32Array, xOff: number, out: Float32Array, outOff: number): void {
+  for (let o = 0; o < rows; o++) {
+    let s = b[o];
+    const w = o * cols;
+    for (let i = 0; i < cols; i++) s += W[w + i] * x[xOff + i];
+    out[outOff + o] = s;
+  }
+}
+
+export interface DecodeResult {
+  offsets: Float32Array; // (F x N x 3) mm
+  pose: Float32Array; // (F x 6) axis-angle (rad), translation (mm)
+}
+
+export class ReferenceDecoder {
+  readonly n: number;
+  private readonly d: number;
+  private readonly x: Float32Array;
+  private readonly h: Float32Array;
+  private readonly qkv: Float32Array;
+  private readonly attn: Float32Array;
+  private readonly hidden: Float32Array;
+  private readonly scores: Float32Array;
+
+  constructor(
+    readonly weights: DecoderWeights,
+    readonly adjacency: Adjacency,
+    readonly m: ModelConstants,
+  ) {
+    this.n = adjacency.offsets.length - 1;
+    this.d = m.d_model;
+    const T = this.n + 1;
+    this.x = new Float32Array(T * this.d);
+    this.h = new Float32Array(T * this.d);
+    this.qkv = new Float32Array(T * 3 * this.d);
+    this.attn = new Float32Array(T * this.d);
+    this.hidden = new Float32Array(m.ffn);
+    this.scores = new Float32Array(T);
+  }
+
+  /** tokens (F x N x d), poseToken (F x d) -> displacement and pose per frame. `layerOut` receives each layer's tokens of frame 0. */
+  decode(tokens: Float32Array, poseToken: Float32Array, frames: number, layerOut?: Float32Array[]): DecodeResult {
+    const { n, d } = this;
+    const offsets = new Float32Array(frames * n * 3);
+    const pose = new Float32Array(frames * 6);
+    for (let f = 0; f < frames; f++) {
+      this.x.set(tokens.subarray(f * n * d, (f + 1) * n * d), 0);
+      this.x.set(poseToken.subarray(f * d, (f + 1) * d), n * d);
+      this.weights.layers.forEach((L, i) => {
+        this.layer(L);
+        if (f === 0 && layerOut) layerOut[i] = this.x.slice();
+      });
+      this.heads(offsets, pose, f);
+    }
+    return { offsets, pose };
+  }
+
+  private layer(L: LayerWeights): void {
+    const { n, d, x, h, qkv, attn } = this;
+    const T = n + 1;
+    const heads = this.m.heads;
+    const dk = d / heads;
+    const scale = 1 / Math.sqrt(dk);
+    for (let t = 0; t < T; t++) {
+      layerNorm(x, t * d, d, L.ln1g, L.ln1b, h, t * d);
+      linear(L.qkvW, L.qkvB, 3 * d, d, h, t * d, qkv, t * 3 * d);
+    }
+    const { offsets: ro, indices: ri } = this.adjacency;
+    for (let t = 0; t < T; t++) {
+      // Keys this token may see: itself and its 1-ring; the pose token (t = n) sees every token.
+      const count = t < n ? 1 + ro[t + 1] - ro[t] : T;
+      const key = (s: number) => (t < n ? (s === 0 ? t : ri[ro[t] + s - 1]) : s);
+      for (let hd = 0; hd < heads; hd++) {
+        const qo = t * 3 * d + hd * dk;
+        let max = -Infinity;
+        for (let s = 0; s < count; s++) {
+          const ko = key(s) * 3 * d + d + hd * dk;
+          let dot = 0;
+          for (let i = 0; i < dk; i++) dot += qkv[qo + i] * qkv[ko + i];
+          this.scores[s] = dot * scale;
+          max = Math.max(max, this.scores[s]);
+        }
+        let sum = 0;
+        for (let s = 0; s < count; s++) {
+          this.scores[s] = Math.exp(this.scores[s] - max);
+          sum += this.scores[s];
+        }
+        const ao = t * d + hd * dk;
+        for (let i = 0; i < dk; i++) attn[ao + i] = 0;
+        for (let s = 0; s < count; s++) {
+          const w = this.scores[s] / sum;
+          const vo = key(s) * 3 * d + 2 * d + hd * dk;
+          for (let i = 0; i < dk; i++) attn[ao + i] += w * qkv[vo + i];
+        }
+      }
+    }
+    for (let t = 0; t < T; t++) {
+      linear(L.outW, L.outB, d, d, attn, t * d, h, t * d);
+      for (let i = 0; i < d; i++) x[t * d + i] += h[t * d + i];
+      layerNorm(x, t * d, d, L.ln2g, L.ln2b, h, t * d);
+      linear(L.ffn1W, L.ffn1B, this.m.ffn, d, h, t * d, this.hidden, 0);
+      for (let i = 0; i < this.m.ffn; i++) this.hidden[i] = gelu(this.hidden[i]);
+      linear(L.ffn2W, L.ffn2B, d, this.m.ffn, this.hidden, 0, attn, t * d);
+      for (let i = 0; i < d; i++) x[t * d + i] += attn[t * d + i];
+    }
+  }
+
+  private heads(offsets: Float32Array, pose: Float32Array, f: number): void {
+    const { n, d, x, h } = this;
+    const w = this.weights;
+    for (let t = 0; t <= n; t++) layerNorm(x, t * d, d, w.lnG, w.lnB, h, t * d);
+    for (let j = 0; j < n; j++) linear(w.dispW, w.dispB, 3, d, h, j * d, offsets, (f * n + j) * 3);
+    const raw = new Float32Array(6);
+    linear(w.poseW, w.poseB, 6, d, h, n * d, raw, 0);
+    for (let i = 0; i < 3; i++) pose[f * 6 + i] = this.m.max_rotation * Math.tanh(raw[i]);
+    for (let i = 3; i < 6; i++) pose[f * 6 + i] = this.m.max_translation_mm * Math.tanh(raw[i]);
+  }
+}
+
+/** y = R (I + O) + t (Eq. 2): template (N x 3) mm, offsets (F x N x 3), pose (F x 6) -> (F x N x 3). Rodrigues' formula. */
+export function applyPose(template: Float32Array, offsets: Float32Array, pose: Float32Array, frames: number, out?: Float32Array): Float32Array {
+  const n = template.length / 3;
+  const y = out ?? new Float32Array(frames * n * 3);
+  for (let f = 0; f < frames; f++) {
+    const [rx, ry, rz, tx, ty, tz] = pose.subarray(f * 6, f * 6 + 6);
+    const th = Math.hypot(rx, ry, rz);
+    const a = th < 1e-6 ? 1 - (th * th) / 6 : Math.sin(th) / th;
+    const b = th < 1e-6 ? 0.5 - (th * th) / 24 : (1 - Math.cos(th)) / (th * th);
+    // R = I + a K + b K^2, K the cross-product matrix of (rx, ry, rz).
+    const R = [
+      1 - b * (ry * ry + rz * rz), -a * rz + b * rx * ry, a * ry + b * rx * rz,
+      a * rz + b * rx * ry, 1 - b * (rx * rx + rz * rz), -a * rx + b * ry * rz,
+      -a * ry + b * rx * rz, a * rx + b * ry * rz, 1 - b * (rx * rx + ry * ry),
+    ];
+    for (let j = 0; j < n; j++) {
+      const o = (f * n + j) * 3;
+      const px = template[3 * j] + offsets[o], py = template[3 * j + 1] + offsets[o + 1], pz = template[3 * j + 2] + offsets[o + 2];
+      y[o] = R[0] * px + R[1] * py + R[2] * pz + tx;
+      y[o + 1] = R[3] * px + R[4] * py + R[5] * pz + ty;
+      y[o + 2] = R[6] * px + R[7] * py + R[8] * pz + tz;
+    }
+  }
+  return y;
+}

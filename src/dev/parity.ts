@@ -1,0 +1,72 @@
+/**
+ * Test page (dev/parity.html, loaded by tests/e2e/engine-parity.spec.ts): runs the TypeScript reference
+ * decoder and the WGSL decoder on the exporter's fixture tokens and reports their differences from
+ * each other and from PyTorch. Not part of the app.
+ */
+import { checkManifest } from '../model/manifest';
+import { parseSafetensors, f32 } from '../model/safetensors';
+import { loadTemplate } from '../template/face-template';
+import { ReferenceDecoder, decoderWeights } from '../attention/reference';
+import { GpuDecoder } from '../attention/gpu-decoder';
+import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
+import { TalkingFaceEngine } from '../engine/engine';
+
+const maxAbsDiff = (a: ArrayLike<number>, b: ArrayLike<number>) => {
+  let m = 0;
+  for (let i = 0; i < a.length; i++) m = Math.max(m, Math.abs(a[i] - b[i]));
+  return m;
+};
+
+async function main() {
+  const manifest = checkManifest(await (await fetch('/models/manifest.json')).json());
+  const bin = async (f: string) => (await fetch(`/models/${f}`)).arrayBuffer();
+  const fx = parseSafetensors(await bin(manifest.fixtures.file)).tensors;
+  const template = await loadTemplate(`/models/${manifest.template.path}`);
+  const m = manifest.model.config;
+  const weights = decoderWeights(parseSafetensors(await bin(manifest.files.decoder_weights)).tensors, m);
+  const frames = manifest.fixtures.token_frames;
+  const tokens = f32(fx, 'tokens');
+  const poseTok = f32(fx, 'pose_token').subarray(0, frames * m.d_model);
+  const cpu = new ReferenceDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
+  const gpu = await detectWebGPU();
+  const result: Record<string, unknown> = { adapter: gpu.info, frames };
+  if (gpu.adapter) {
+    const device = await requestSharedDevice();
+    const dec = new GpuDecoder(device, weights, template.adjacency, m, 8);
+    const g = await dec.decode(tokens, poseTok, frames);
+    result.gpuVsCpuOffsets = maxAbsDiff(g.offsets, cpu.offsets);
+    result.gpuVsCpuPose = maxAbsDiff(g.pose, cpu.pose);
+    result.gpuVsTorchOffsets = maxAbsDiff(g.offsets, f32(fx, 'offsets'));
+    // A second call reuses the buffers: same answer.
+    const again = await dec.decode(tokens, poseTok, frames);
+    result.gpuRepeatable = maxAbsDiff(again.offsets, g.offsets) === 0;
+    dec.destroy();
+  }
+  result.cpuVsTorchOffsets = maxAbsDiff(cpu.offsets, f32(fx, 'offsets'));
+  result.cpuVsTorchPose = maxAbsDiff(cpu.pose, f32(fx, 'pose'));
+
+  // The whole engine (meyda Mel, ONNX encoders on onnxruntime-web, decoder, posing) on the fixture clip,
+  // against PyTorch's vertices, in the template's units; in one chunk and in chunks of 5 frames.
+  const audio = f32(fx, 'audio');
+  const mmPerUnit = { mm: 1, cm: 10, m: 1000 }[template.units];
+  const torchVertices = Float32Array.from(f32(fx, 'vertices'), (v) => v / mmPerUnit);
+  const engine = await TalkingFaceEngine.load({ backend: 'cpu', onnxProviders: ['wasm'] });
+  const whole = await engine.animate(audio);
+  const chunked = await engine.animate(audio, { chunkFrames: 5 });
+  result.engineFrames = whole.frames;
+  result.engineCpuVsTorch = maxAbsDiff(whole.vertices, torchVertices);
+  result.engineChunkedVsWhole = maxAbsDiff(chunked.vertices, whole.vertices);
+  if (gpu.adapter) {
+    await engine.setBackend('webgpu');
+    const g = await engine.animate(audio, { chunkFrames: 7 });
+    result.engineGpuVsCpu = maxAbsDiff(g.vertices, whole.vertices);
+    result.engineBackend = engine.backend;
+  }
+  Object.assign(globalThis, { parityResult: result });
+  document.getElementById('status')!.textContent = JSON.stringify(result);
+}
+
+main().catch((e: Error) => {
+  Object.assign(globalThis, { parityResult: { error: e.message } });
+  document.getElementById('status')!.textContent = `error: ${e.message}`;
+});

@@ -1,0 +1,306 @@
+/**
+ * The inference engine: audio samples in, posed face frames out, in bounded memory.
+ *
+ *   samples (mono, manifest rate) -> log-Mel (meyda) -> content encoder (ONNX) -> windows of phone
+ *   posteriors -> hierarchical tokens (ONNX) ; log-Mel -> pose conv + LSTM (ONNX, state carried)
+ *   -> GAVA decoder (WGSL or TypeScript) -> y = R (I + O) + t  -> frames in the template's units
+ *
+ * Frames are produced in chunks; every chunk recomputes the Mel and content frames it needs with
+ * enough context on each side that the result equals the whole-clip computation exactly, so memory
+ * holds one chunk of intermediates whatever the clip's length. Library code: no DOM.
+ */
+import { checkManifest, frameToMelIndex, type Manifest } from '../model/manifest';
+import { parseSafetensors } from '../model/safetensors';
+import { OnnxModel, type ExecutionProvider, ModelLoadError } from '../model/onnx-sessions';
+import { contentWindows, softmaxRows } from '../model/windows';
+import { logMelFrames, melFrameCount } from '../audio/mel';
+import { ReferenceDecoder, applyPose, decoderWeights, type DecodeResult } from '../attention/reference';
+import { GpuDecoder } from '../attention/gpu-decoder';
+import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
+import { loadTemplate, type FaceTemplate } from '../template/face-template';
+
+export type Backend = 'webgpu' | 'cpu';
+
+export interface EngineOptions {
+  /** URL of models/manifest.json (default: /models/manifest.json). */
+  manifestUrl?: string | URL;
+  /** 'auto' (default): WebGPU when an adapter exists, else the CPU decoder. */
+  backend?: 'auto' | Backend;
+  /** Execution providers for the ONNX encoders, in order of preference. */
+  onnxProviders?: ExecutionProvider[];
+  fetch?: typeof fetch;
+}
+
+export interface AnimateOptions {
+  /** Frames per chunk (default 96). */
+  chunkFrames?: number;
+  /** Called after each chunk with the frames done so far. */
+  onProgress?: (done: number, total: number) => void;
+  /** Receives each chunk's frames instead of (or as well as) the returned buffer. */
+  onFrames?: (first: number, vertices: Float32Array, pose: Float32Array) => void;
+  /** false: do not keep all frames (use onFrames); memory then stays one chunk. Default true. */
+  keep?: boolean;
+  signal?: AbortSignal;
+}
+
+export interface Animation {
+  fps: number;
+  frames: number;
+  /** (frames x N x 3) posed vertices in the template's units, or empty when keep = false. */
+  vertices: Float32Array;
+  /** (frames x 6): axis-angle (rad), translation (mm). */
+  pose: Float32Array;
+}
+
+export interface StageTimes {
+  mel: number;
+  content: number;
+  hierarchical: number;
+  pose: number;
+  decoder: number;
+  posing: number;
+}
+
+/** Mel frames of context around a chunk: the convolutions' reach (content: 7, pose: 3), rounded up. */
+const MEL_CONTEXT = 16;
+
+export class TalkingFaceEngine {
+  readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
+  private gpu: GpuDecoder | null;
+  private readonly cpu: ReferenceDecoder;
+  private readonly templateMm: Float32Array;
+  private readonly mmPerUnit: number;
+  backend: Backend;
+  /** Why the backend is what it is, for the status line. */
+  backendReason: string;
+
+  private constructor(
+    readonly manifest: Manifest,
+    readonly template: FaceTemplate,
+    private readonly content: OnnxModel,
+    private readonly hierarchical: OnnxModel,
+    private readonly poseConv: OnnxModel,
+    private readonly poseLstm: OnnxModel,
+    cpu: ReferenceDecoder,
+    gpu: GpuDecoder | null,
+    backendReason: string,
+  ) {
+    this.cpu = cpu;
+    this.gpu = gpu;
+    this.backend = gpu ? 'webgpu' : 'cpu';
+    this.backendReason = backendReason;
+    this.mmPerUnit = { mm: 1, cm: 10, m: 1000 }[template.units];
+    this.templateMm = Float32Array.from(template.positions, (v) => v * this.mmPerUnit);
+  }
+
+  static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
+    const fetchFn = options.fetch ?? fetch.bind(globalThis);
+    const manifestUrl = new URL(String(options.manifestUrl ?? '/models/manifest.json'), globalThis.location?.href ?? 'file:///');
+    const res = await fetchFn(manifestUrl).catch((e: Error) => {
+      throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}`);
+    });
+    if (!res.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${res.status}`);
+    let manifest: Manifest;
+    try {
+      manifest = checkManifest(await res.json());
+    } catch (e) {
+      throw new ModelLoadError(`the model manifest ${manifestUrl} is unreadable: ${(e as Error).message}`);
+    }
+    const file = async (key: string): Promise<ArrayBuffer> => {
+      const url = new URL(manifest.files[key], manifestUrl);
+      const r = await fetchFn(url);
+      if (!r.ok) throw new ModelLoadError(`model file ${manifest.files[key]} is missing (HTTP ${r.status} for ${url})`);
+      const bytes = await r.arrayBuffer();
+      const digest = Array.from(new Uint8Array(await crypto.subtle.digest('SHA-256', bytes)), (b) => b.toString(16).padStart(2, '0')).join('');
+      if (digest !== manifest.sha256[key]) throw new ModelLoadError(`model file ${manifest.files[key]} is corrupt or from another export (SHA-256 mismatch)`);
+      return bytes;
+    };
+    const m = manifest.model.config;
+    const a = manifest.audio;
+    const [template, contentBytes, hierBytes, convBytes, lstmBytes, weightBytes] = await Promise.all([
+      loadTemplate(new URL(manifest.template.path, manifestUrl), fetchFn),
+      file('content_encoder'), file('hierarchical'), file('pose_conv'), file('pose_lstm'), file('decoder_weights'),
+    ]);
+    if (template.id !== manifest.template.id) throw new ModelLoadError(`the model expects template ${manifest.template.id}, got ${template.id}`);
+    const providers = options.onnxProviders;
+    const [content, hierarchical, poseConv, poseLstm] = await Promise.all([
+      OnnxModel.create({ name: 'content_encoder', bytes: contentBytes, inputs: { mel: [1, 'K', a.n_mels] } }, providers),
+      OnnxModel.create({ name: 'hierarchical', bytes: hierBytes, inputs: { windows: ['F', m.window, m.content_classes] } }, providers),
+      OnnxModel.create({ name: 'pose_conv', bytes: convBytes, inputs: { mel: [1, 'K', a.n_mels] } }, providers),
+      OnnxModel.create({ name: 'pose_lstm', bytes: lstmBytes, inputs: { conv: [1, 'K', m.pose_channels], h0: [1, 1, m.pose_channels], c0: [1, 1, m.pose_channels] } }, providers),
+    ]);
+    const weights = decoderWeights(parseSafetensors(weightBytes).tensors, m);
+    const cpu = new ReferenceDecoder(weights, template.adjacency, m);
+    let gpu: GpuDecoder | null = null;
+    let reason = 'CPU decoder chosen';
+    if (options.backend !== 'cpu') {
+      const support = await detectWebGPU();
+      if (support.adapter) {
+        try {
+          const device = await requestSharedDevice();
+          gpu = new GpuDecoder(device, weights, template.adjacency, m, 96);
+          reason = `WebGPU: ${support.description}`;
+          device.lost.then((info) => {
+            // A lost device (driver reset, tab backgrounded on some systems): carry on with the CPU decoder.
+            reason = `WebGPU device lost (${info.message || info.reason}); using the CPU decoder`;
+            return undefined;
+          });
+        } catch (e) {
+          reason = `WebGPU device request failed (${(e as Error).message}); using the CPU decoder`;
+        }
+      } else {
+        reason = `no WebGPU (${support.description}); using the CPU decoder`;
+      }
+      if (options.backend === 'webgpu' && !gpu) throw new ModelLoadError(`WebGPU was requested but is not available: ${reason}`);
+    }
+    const engine = new TalkingFaceEngine(manifest, template, content, hierarchical, poseConv, poseLstm, cpu, gpu, reason);
+    return engine;
+  }
+
+  get fps(): number {
+    return this.manifest.audio.fps;
+  }
+
+  /** Frames produced for `samples` samples: round(duration * fps). */
+  frameCount(samples: number): number {
+    return Math.max(1, Math.round((samples / this.manifest.audio.sample_rate) * this.fps));
+  }
+
+  /** The whole clip, chunk by chunk. `samples` must be mono at manifest.audio.sample_rate. */
+  async animate(samples: Float32Array, options: AnimateOptions = {}): Promise<Animation> {
+    const a = this.manifest.audio;
+    const m = this.manifest.model.config;
+    const n = this.template.vertexCount;
+    const F = this.frameCount(samples.length);
+    const chunk = Math.max(1, options.chunkFrames ?? 96);
+    const keep = options.keep ?? true;
+    const vertices = keep ? new Float32Array(F * n * 3) : new Float32Array(0);
+    const pose = new Float32Array(F * 6);
+    const K = melFrameCount(samples.length, a);
+    const Kc = Math.ceil(K / m.content_stride);
+    const C = m.pose_channels;
+    let h = new Float32Array(C);
+    let c = new Float32Array(C);
+    let lstmDone = 0; // Mel frames the pose LSTM has consumed
+    let poseFeatures = new Float32Array(0);
+    let poseFeaturesStart = 0;
+    for (let f0 = 0; f0 < F; f0 += chunk) {
+      options.signal?.throwIfAborted();
+      const f1 = Math.min(F, f0 + chunk);
+      const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));
+      // Content frames the windows need, and the Mel frames (with context) that produce them.
+      const cLo = Math.max(0, Math.floor(melIndex[0] / m.content_stride) - (m.window - 1 - m.window_future));
+      const cHi = Math.min(Kc, Math.floor(melIndex[melIndex.length - 1] / m.content_stride) + m.window_future + 1);
+      const melLo = Math.max(0, cLo * m.content_stride - MEL_CONTEXT);
+      const melHi = Math.min(K, Math.max(cHi * m.content_stride, melIndex[melIndex.length - 1] + 1) + MEL_CONTEXT);
+      let t = performance.now();
+      const mel = logMelFrames(samples, a, melLo, melHi - melLo);
+      this.times.mel += performance.now() - t;
+
+      t = performance.now();
+      const logits = (await this.content.run({ mel: { data: mel, shape: [1, melHi - melLo, a.n_mels] } })).logits.data;
+      // Content frame j of this run is clip content frame melLo / stride + j (melLo is a multiple of the stride
+      // or 0, so the convolution's stride lines up with the whole-clip computation).
+      const runOffset = melLo / m.content_stride;
+      const post = softmaxRows(logits.slice((cLo - runOffset) * m.content_classes, (cHi - runOffset) * m.content_classes), m.content_classes);
+      const windows = contentWindows(post, melIndex, m, cLo, Kc);
+      this.times.content += performance.now() - t;
+
+      t = performance.now();
+      const tokens = (await this.hierarchical.run({ windows: { data: windows, shape: [melIndex.length, m.window, m.content_classes] } })).tokens.data;
+      this.times.hierarchical += performance.now() - t;
+
+      // Pose: the LSTM advances over every Mel frame up to this chunk's last one, exactly once.
+      t = performance.now();
+      const need = melIndex[melIndex.length - 1] + 1;
+      if (need > lstmDone) {
+        const ctxLo = Math.max(0, lstmDone - MEL_CONTEXT);
+        const ctxHi = Math.min(K, need + MEL_CONTEXT);
+        const melPose = ctxLo >= melLo && ctxHi <= melHi ? mel.subarray((ctxLo - melLo) * a.n_mels, (ctxHi - melLo) * a.n_mels) : logMelFrames(samples, a, ctxLo, ctxHi - ctxLo);
+        const conv = (await this.poseConv.run({ mel: { data: melPose, shape: [1, ctxHi - ctxLo, a.n_mels] } })).conv.data;
+        const fresh = conv.slice((lstmDone - ctxLo) * C, (need - ctxLo) * C);
+        const out = await this.poseLstm.run({
+          conv: { data: fresh, shape: [1, need - lstmDone, C] },
+          h0: { data: h, shape: [1, 1, C] },
+          c0: { data: c, shape: [1, 1, C] },
+        });
+        h = out.hn.data.slice();
+        c = out.cn.data.slice();
+        // Keep only the pose features this and later chunks can still ask for: from this chunk's first
+        // Mel frame, or from where the LSTM stopped if that is earlier (new features start there).
+        const keepFrom = Math.min(melIndex[0], lstmDone);
+        const old = poseFeatures.subarray((keepFrom - poseFeaturesStart) * m.d_model);
+        const merged = new Float32Array(old.length + out.pose_features.data.length);
+        merged.set(old);
+        merged.set(out.pose_features.data, old.length);
+        poseFeaturesStart = keepFrom;
+        poseFeatures = merged;
+        lstmDone = need;
+      }
+      const poseToken = new Float32Array(melIndex.length * m.d_model);
+      melIndex.forEach((k, i) => poseToken.set(poseFeatures.subarray((k - poseFeaturesStart) * m.d_model, (k - poseFeaturesStart + 1) * m.d_model), i * m.d_model));
+      this.times.pose += performance.now() - t;
+
+      t = performance.now();
+      const decoded = await this.decode(tokens, poseToken, melIndex.length);
+      this.times.decoder += performance.now() - t;
+
+      t = performance.now();
+      const y = applyPose(this.templateMm, decoded.offsets, decoded.pose, melIndex.length);
+      for (let i = 0; i < y.length; i++) y[i] /= this.mmPerUnit;
+      pose.set(decoded.pose, f0 * 6);
+      if (keep) vertices.set(y, f0 * n * 3);
+      this.times.posing += performance.now() - t;
+      options.onFrames?.(f0, y, decoded.pose);
+      options.onProgress?.(f1, F);
+    }
+    return { fps: this.fps, frames: F, vertices, pose };
+  }
+
+  private async decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
+    if (this.gpu) {
+      try {
+        const out: DecodeResult = { offsets: new Float32Array(frames * this.template.vertexCount * 3), pose: new Float32Array(frames * 6) };
+        const step = this.gpu.maxFrames;
+        const n = this.template.vertexCount;
+        const d = this.manifest.model.config.d_model;
+        for (let i = 0; i < frames; i += step) {
+          const j = Math.min(frames, i + step);
+          const r = await this.gpu.decode(tokens.subarray(i * n * d, j * n * d), poseToken.subarray(i * d, j * d), j - i);
+          out.offsets.set(r.offsets, i * n * 3);
+          out.pose.set(r.pose, i * 6);
+        }
+        return out;
+      } catch (e) {
+        // The animation goes on: switch to the CPU decoder for this and every later chunk.
+        this.gpu.destroy();
+        this.gpu = null;
+        this.backend = 'cpu';
+        this.backendReason = `WebGPU failed (${(e as Error).message}); using the CPU decoder`;
+      }
+    }
+    return this.cpu.decode(tokens, poseToken, frames);
+  }
+
+  /** Switch decoders at run time (the numbers are the same; only speed differs). */
+  async setBackend(backend: Backend): Promise<void> {
+    if (backend === this.backend) return;
+    if (backend === 'cpu') {
+      this.gpu?.destroy();
+      this.gpu = null;
+      this.backend = 'cpu';
+      this.backendReason = 'CPU decoder chosen';
+      return;
+    }
+    const support = await detectWebGPU();
+    if (!support.adapter) throw new ModelLoadError(`WebGPU is not available: ${support.description}`);
+    const device = await requestSharedDevice();
+    this.gpu = new GpuDecoder(device, this.cpu.weights, this.template.adjacency, this.manifest.model.config, 96);
+    this.backend = 'webgpu';
+    this.backendReason = `WebGPU: ${support.description}`;
+  }
+
+  resetTimes(): void {
+    for (const k of Object.keys(this.times) as (keyof StageTimes)[]) this.times[k] = 0;
+  }
+}

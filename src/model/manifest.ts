@@ -1,0 +1,68 @@
+/**
+ * models/manifest.json: the one source of every number the browser shares with training
+ * (sample rate, Mel, fps, window, token size), written by training/src/talkingface/export.py.
+ */
+
+export const MANIFEST_FORMAT = 'talking-face-model';
+
+export interface AudioConstants {
+  sample_rate: number;
+  frame_size: number;
+  hop: number;
+  n_mels: number;
+  fps: number;
+  feature_rate: number;
+}
+
+export interface ModelConstants {
+  features: string;
+  decoder: string;
+  variant: string;
+  d_model: number;
+  heads: number;
+  layers: number;
+  ffn: number;
+  content_classes: number;
+  window: number;
+  window_future: number;
+  content_stride: number;
+  pose_channels: number;
+  max_rotation: number;
+  max_translation_mm: number;
+}
+
+export interface Manifest {
+  format: typeof MANIFEST_FORMAT;
+  version: number;
+  model: { name: string; config: ModelConstants; trained_steps: number; trained_minutes: number; parameters: number };
+  audio: AudioConstants;
+  template: { id: string; units: string; vertices: number; path: string };
+  files: Record<string, string>;
+  runtime_files: string[];
+  sha256: Record<string, string>;
+  decoder_tensors: Record<string, number[]>;
+  fixtures: { file: string; frames: number; token_frames: number };
+  look_ahead_ms: number;
+}
+
+export class ManifestError extends Error {
+  override name = 'ManifestError';
+}
+
+export function checkManifest(m: unknown): Manifest {
+  const x = m as Manifest;
+  if (!x || x.format !== MANIFEST_FORMAT) throw new ManifestError(`not a talking-face model manifest (expected "format": "${MANIFEST_FORMAT}")`);
+  if (x.version !== 1) throw new ManifestError(`model manifest version ${x.version} is not supported by this build (1)`);
+  for (const key of ['sample_rate', 'frame_size', 'hop', 'n_mels', 'fps'] as const) {
+    if (!Number.isFinite(x.audio?.[key])) throw new ManifestError(`model manifest lacks audio.${key}`);
+  }
+  return x;
+}
+
+/** Mel frame of animation frame i: round(i / fps * feature_rate), half to even (numpy's rounding). */
+export function frameToMelIndex(frame: number, a: AudioConstants): number {
+  const x = (frame / a.fps) * a.feature_rate;
+  const r = Math.round(x);
+  // Math.round rounds halves up; numpy rounds them to even.
+  return Math.abs(x - Math.trunc(x)) === 0.5 && r % 2 !== 0 ? r - 1 : r;
+}

@@ -1,0 +1,25 @@
+import { test, expect } from './fixtures';
+
+/**
+ * The WGSL GAVA decoder in headless Chromium (WebGPU on SwiftShader, software but exact) against the
+ * TypeScript reference and against PyTorch, on the exporter's fixture tokens (dev/parity.html).
+ */
+test('WGSL decoder = TypeScript reference = PyTorch, and the whole engine = PyTorch', async ({ page }) => {
+  await page.goto('/dev/parity.html');
+  const result = await page.waitForFunction(() => (globalThis as unknown as { parityResult?: unknown }).parityResult, null, { timeout: 60_000 });
+  const r = (await result.jsonValue()) as Record<string, number | boolean | string | { architecture: string } | null>;
+  expect(r.error, String(r.error)).toBeUndefined();
+  expect((r.adapter as { architecture: string }).architecture).toBe('swiftshader');
+  expect(r.gpuVsCpuOffsets as number).toBeLessThan(1e-4);
+  expect(r.gpuVsCpuPose as number).toBeLessThan(1e-5);
+  expect(r.gpuVsTorchOffsets as number).toBeLessThan(1e-4);
+  expect(r.cpuVsTorchOffsets as number).toBeLessThan(1e-4);
+  expect(r.cpuVsTorchPose as number).toBeLessThan(1e-5);
+  expect(r.gpuRepeatable).toBe(true);
+  // The whole engine against PyTorch's final vertices (template units: cm), chunked = whole, WebGPU = CPU.
+  expect(r.engineFrames).toBe(18);
+  expect(r.engineCpuVsTorch as number).toBeLessThan(1e-4);
+  expect(r.engineChunkedVsWhole as number).toBeLessThan(1e-5);
+  expect(r.engineGpuVsCpu as number).toBeLessThan(1e-5);
+  expect(r.engineBackend).toBe('webgpu');
+});

@@ -1,0 +1,94 @@
+/**
+ * The browser's inference path, stage by stage, against the tensors PyTorch computed for the same clip
+ * (models/fixtures, written by the exporter): Mel (meyda), content windows, the ONNX encoders on
+ * onnxruntime-node, the TypeScript GAVA decoder, and the posed vertices.
+ */
+import { describe, expect, it, beforeAll } from 'vitest';
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import * as ort from 'onnxruntime-node';
+import { checkManifest, frameToMelIndex, type Manifest } from '../../src/model/manifest';
+import { parseSafetensors, f32, type Tensor } from '../../src/model/safetensors';
+import { logMel } from '../../src/audio/mel';
+import { contentWindows, softmaxRows } from '../../src/model/windows';
+import { ReferenceDecoder, applyPose, decoderWeights } from '../../src/attention/reference';
+import { decodeTemplate } from '../../src/template/face-template';
+
+const MODELS = resolve(import.meta.dirname, '../..', process.env.MODELS_DIR ?? 'models');
+const buf = (p: string) => {
+  const b = readFileSync(resolve(MODELS, p));
+  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer;
+};
+
+let manifest: Manifest;
+let fx: Map<string, Tensor>;
+const maxAbsDiff = (a: ArrayLike<number>, b: ArrayLike<number>) => {
+  expect(a.length).toBe(b.length);
+  let m = 0;
+  for (let i = 0; i < a.length; i++) m = Math.max(m, Math.abs(a[i] - b[i]));
+  return m;
+};
+
+beforeAll(() => {
+  manifest = checkManifest(JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8')));
+  fx = parseSafetensors(buf(manifest.fixtures.file)).tensors;
+});
+
+async function run(file: string, feeds: Record<string, ort.Tensor>): Promise<Record<string, ort.Tensor>> {
+  const s = await ort.InferenceSession.create(resolve(MODELS, file));
+  return s.run(feeds) as Promise<Record<string, ort.Tensor>>;
+}
+
+describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
+  it('log-Mel with meyda matches Python', () => {
+    const mel = logMel(f32(fx, 'audio'), manifest.audio);
+    expect(maxAbsDiff(mel, f32(fx, 'mel'))).toBeLessThan(1e-4);
+  });
+
+  it('frame -> Mel index and the content windows match', () => {
+    const melIndex = fx.get('mel_index')!.data as BigInt64Array;
+    for (let i = 0; i < melIndex.length; i++) expect(frameToMelIndex(i, manifest.audio)).toBe(Number(melIndex[i]));
+    const post = softmaxRows(f32(fx, 'content_logits').slice(), manifest.model.config.content_classes);
+    const win = contentWindows(post, Array.from(melIndex, Number), manifest.model.config);
+    expect(maxAbsDiff(win, f32(fx, 'windows'))).toBeLessThan(1e-6);
+  });
+
+  it('the ONNX encoders on onnxruntime-node match PyTorch within 1e-5', async () => {
+    const m = manifest.model.config;
+    const mel = f32(fx, 'mel');
+    const K = mel.length / manifest.audio.n_mels;
+    const melT = new ort.Tensor('float32', mel, [1, K, manifest.audio.n_mels]);
+    const logits = (await run(manifest.files.content_encoder, { mel: melT })).logits.data as Float32Array;
+    expect(maxAbsDiff(logits, f32(fx, 'content_logits'))).toBeLessThan(1e-5);
+    const win = f32(fx, 'windows');
+    const F = win.length / (m.window * m.content_classes);
+    const tokens = (await run(manifest.files.hierarchical, { windows: new ort.Tensor('float32', win, [F, m.window, m.content_classes]) })).tokens.data as Float32Array;
+    const want = f32(fx, 'tokens');
+    expect(maxAbsDiff(tokens.subarray(0, want.length), want)).toBeLessThan(1e-5);
+    const conv = (await run(manifest.files.pose_conv, { mel: melT })).conv;
+    expect(maxAbsDiff(conv.data as Float32Array, f32(fx, 'pose_conv'))).toBeLessThan(1e-5);
+    const z = new ort.Tensor('float32', new Float32Array(m.pose_channels), [1, 1, m.pose_channels]);
+    const pf = (await run(manifest.files.pose_lstm, { conv, h0: z, c0: z })).pose_features.data as Float32Array;
+    expect(maxAbsDiff(pf, f32(fx, 'pose_features'))).toBeLessThan(1e-5);
+  });
+
+  it('the TypeScript GAVA decoder matches PyTorch layer by layer, and the posed vertices', async () => {
+    const m = manifest.model.config;
+    const template = await decodeTemplate(JSON.parse(readFileSync(resolve(MODELS, manifest.template.path), 'utf8')), buf(manifest.template.path.replace('.json', '.bin')));
+    const weights = decoderWeights(parseSafetensors(buf(manifest.files.decoder_weights)).tensors, m);
+    const dec = new ReferenceDecoder(weights, template.adjacency, m);
+    const frames = manifest.fixtures.token_frames;
+    const layers: Float32Array[] = [];
+    const poseTok = f32(fx, 'pose_token');
+    const out = dec.decode(f32(fx, 'tokens'), poseTok, frames, layers);
+    for (let i = 0; i < m.layers; i++) {
+      const want = f32(fx, `layer${i}`);
+      expect(maxAbsDiff(layers[i], want.subarray(0, layers[i].length))).toBeLessThan(1e-4);
+    }
+    const wantOffsets = f32(fx, 'offsets').subarray(0, out.offsets.length);
+    expect(maxAbsDiff(out.offsets, wantOffsets)).toBeLessThan(1e-4);
+    expect(maxAbsDiff(out.pose, f32(fx, 'pose').subarray(0, out.pose.length))).toBeLessThan(1e-5);
+    const y = applyPose(f32(fx, 'template_mm'), out.offsets, out.pose, frames);
+    expect(maxAbsDiff(y, f32(fx, 'vertices').subarray(0, y.length))).toBeLessThan(1e-3); // mm: 1e-4 of the template's cm
+  });
+});
