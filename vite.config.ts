@@ -72,9 +72,13 @@ export default defineConfig({
     target: 'es2022',
     sourcemap: true,
     chunkSizeWarningLimit: 1024,
-    // dev/parity.html is a test page for the engine's parity checks (tests/e2e/engine-parity.spec.ts).
+    // dev/parity.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
     rolldownOptions: {
-      input: { main: resolve(import.meta.dirname, 'index.html'), parity: resolve(import.meta.dirname, 'dev/parity.html') },
+      input: {
+        main: resolve(import.meta.dirname, 'index.html'),
+        parity: resolve(import.meta.dirname, 'dev/parity.html'),
+        bench: resolve(import.meta.dirname, 'dev/bench.html'),
+      },
     },
   },
   optimizeDeps: { exclude: ['onnxruntime-web'] },

@@ -56,6 +56,26 @@ async function main() {
   result.engineFrames = whole.frames;
   result.engineCpuVsTorch = maxAbsDiff(whole.vertices, torchVertices);
   result.engineChunkedVsWhole = maxAbsDiff(chunked.vertices, whole.vertices);
+
+  // Streaming: the same audio pushed in irregular pieces gives the same frames as the offline animation.
+  const streamed = new Float32Array(whole.vertices.length);
+  let emitted = 0;
+  const stream = engine.createStream((first, frames) => {
+    streamed.set(frames.vertices, first * template.vertexCount * 3);
+    emitted += frames.count;
+  });
+  const pieces = [1234, 128, 4000, 77, 3000];
+  for (let i = 0, k = 0; i < audio.length; k++) {
+    const size = pieces[k % pieces.length];
+    await stream.push(audio.subarray(i, i + size));
+    i += size;
+  }
+  const beforeEnd = emitted;
+  await stream.end();
+  result.streamFrames = emitted;
+  result.streamFramesBeforeEnd = beforeEnd;
+  result.streamVsOffline = maxAbsDiff(streamed, whole.vertices);
+  result.streamLookAheadMs = stream.lookAheadMs;
   if (gpu.adapter) {
     await engine.setBackend('webgpu');
     const g = await engine.animate(audio, { chunkFrames: 7 });

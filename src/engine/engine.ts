@@ -14,7 +14,7 @@ import { parseSafetensors } from '../model/safetensors';
 import { OnnxModel, type ExecutionProvider, ModelLoadError } from '../model/onnx-sessions';
 import { contentWindows, softmaxRows } from '../model/windows';
 import { logMelFrames, melFrameCount } from '../audio/mel';
-import { ReferenceDecoder, applyPose, decoderWeights, type DecodeResult } from '../attention/reference';
+import { ReferenceDecoder, applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
 import { loadTemplate, type FaceTemplate } from '../template/face-template';
@@ -24,9 +24,12 @@ export type Backend = 'webgpu' | 'cpu';
 export interface EngineOptions {
   /** URL of models/manifest.json (default: /models/manifest.json). */
   manifestUrl?: string | URL;
-  /** 'auto' (default): WebGPU when an adapter exists, else the CPU decoder. */
+  /**
+   * 'auto' (default): WebGPU on a hardware adapter, else the CPU decoder. A software fallback adapter
+   * (SwiftShader) computes the same numbers, more slowly than the CPU path; ask for 'webgpu' to use it anyway.
+   */
   backend?: 'auto' | Backend;
-  /** Execution providers for the ONNX encoders, in order of preference. */
+  /** Execution providers for the ONNX encoders, in order of preference (default: webgpu then wasm on a hardware adapter, else wasm). */
   onnxProviders?: ExecutionProvider[];
   fetch?: typeof fetch;
 }
@@ -40,6 +43,8 @@ export interface AnimateOptions {
   onFrames?: (first: number, vertices: Float32Array, pose: Float32Array) => void;
   /** false: do not keep all frames (use onFrames); memory then stays one chunk. Default true. */
   keep?: boolean;
+  /** Also keep the unposed face I + O per frame (what a renderer that poses the head itself wants). */
+  unposed?: boolean;
   signal?: AbortSignal;
 }
 
@@ -50,6 +55,8 @@ export interface Animation {
   vertices: Float32Array;
   /** (frames x 6): axis-angle (rad), translation (mm). */
   pose: Float32Array;
+  /** (frames x N x 3) I + O in the template's units, when asked for. */
+  unposed?: Float32Array;
 }
 
 export interface StageTimes {
@@ -61,8 +68,29 @@ export interface StageTimes {
   posing: number;
 }
 
-/** Mel frames of context around a chunk: the convolutions' reach (content: 7, pose: 3), rounded up. */
+/** Mel frames of context around a chunk: more than the convolutions' reach (manifest.receptive_field). */
 const MEL_CONTEXT = 16;
+
+/** Frames of one chunk: posed vertices and I + O in the template's units, poses (axis-angle, mm). */
+export interface Frames {
+  count: number;
+  vertices: Float32Array;
+  unposed: Float32Array;
+  pose: Float32Array;
+}
+
+/** What carries from one chunk to the next: the pose LSTM's state and the pose features still needed. */
+export interface ProducerState {
+  h: Float32Array;
+  c: Float32Array;
+  lstmDone: number;
+  poseFeatures: Float32Array;
+  poseFeaturesStart: number;
+}
+
+function newProducerState(channels: number): ProducerState {
+  return { h: new Float32Array(channels), c: new Float32Array(channels), lstmDone: 0, poseFeatures: new Float32Array(0), poseFeaturesStart: 0 };
+}
 
 export class TalkingFaceEngine {
   readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
@@ -122,7 +150,9 @@ export class TalkingFaceEngine {
       file('content_encoder'), file('hierarchical'), file('pose_conv'), file('pose_lstm'), file('decoder_weights'),
     ]);
     if (template.id !== manifest.template.id) throw new ModelLoadError(`the model expects template ${manifest.template.id}, got ${template.id}`);
-    const providers = options.onnxProviders;
+    const support = await detectWebGPU();
+    const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
+    const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
     const [content, hierarchical, poseConv, poseLstm] = await Promise.all([
       OnnxModel.create({ name: 'content_encoder', bytes: contentBytes, inputs: { mel: [1, 'K', a.n_mels] } }, providers),
       OnnxModel.create({ name: 'hierarchical', bytes: hierBytes, inputs: { windows: ['F', m.window, m.content_classes] } }, providers),
@@ -133,18 +163,16 @@ export class TalkingFaceEngine {
     const cpu = new ReferenceDecoder(weights, template.adjacency, m);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';
-    if (options.backend !== 'cpu') {
-      const support = await detectWebGPU();
+    const wantGpu = options.backend === 'webgpu' || ((options.backend ?? 'auto') === 'auto' && hardwareGpu);
+    if (support.adapter && !hardwareGpu && options.backend !== 'webgpu') {
+      reason = `the WebGPU adapter (${support.description}) is software, slower than the CPU path; using the CPU decoder`;
+    }
+    if (wantGpu) {
       if (support.adapter) {
         try {
           const device = await requestSharedDevice();
           gpu = new GpuDecoder(device, weights, template.adjacency, m, 96);
           reason = `WebGPU: ${support.description}`;
-          device.lost.then((info) => {
-            // A lost device (driver reset, tab backgrounded on some systems): carry on with the CPU decoder.
-            reason = `WebGPU device lost (${info.message || info.reason}); using the CPU decoder`;
-            return undefined;
-          });
         } catch (e) {
           reason = `WebGPU device request failed (${(e as Error).message}); using the CPU decoder`;
         }
@@ -154,7 +182,18 @@ export class TalkingFaceEngine {
       if (options.backend === 'webgpu' && !gpu) throw new ModelLoadError(`WebGPU was requested but is not available: ${reason}`);
     }
     const engine = new TalkingFaceEngine(manifest, template, content, hierarchical, poseConv, poseLstm, cpu, gpu, reason);
+    gpu?.device.lost.then((info) => engine.deviceLost(gpu, info));
     return engine;
+  }
+
+  /** The decoder's weights (shared by the CPU and WebGPU decoders). */
+  get decoderWeights(): DecoderWeights {
+    return this.cpu.weights;
+  }
+
+  /** Template units per mm (the model works in mm; poses carry mm translations). */
+  get unitsPerMm(): number {
+    return 1 / this.mmPerUnit;
   }
 
   get fps(): number {
@@ -168,93 +207,126 @@ export class TalkingFaceEngine {
 
   /** The whole clip, chunk by chunk. `samples` must be mono at manifest.audio.sample_rate. */
   async animate(samples: Float32Array, options: AnimateOptions = {}): Promise<Animation> {
-    const a = this.manifest.audio;
-    const m = this.manifest.model.config;
     const n = this.template.vertexCount;
     const F = this.frameCount(samples.length);
     const chunk = Math.max(1, options.chunkFrames ?? 96);
     const keep = options.keep ?? true;
     const vertices = keep ? new Float32Array(F * n * 3) : new Float32Array(0);
     const pose = new Float32Array(F * 6);
-    const K = melFrameCount(samples.length, a);
-    const Kc = Math.ceil(K / m.content_stride);
-    const C = m.pose_channels;
-    let h = new Float32Array(C);
-    let c = new Float32Array(C);
-    let lstmDone = 0; // Mel frames the pose LSTM has consumed
-    let poseFeatures = new Float32Array(0);
-    let poseFeaturesStart = 0;
+    const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
+    const state = newProducerState(this.manifest.model.config.pose_channels);
     for (let f0 = 0; f0 < F; f0 += chunk) {
       options.signal?.throwIfAborted();
       const f1 = Math.min(F, f0 + chunk);
-      const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));
-      // Content frames the windows need, and the Mel frames (with context) that produce them.
-      const cLo = Math.max(0, Math.floor(melIndex[0] / m.content_stride) - (m.window - 1 - m.window_future));
-      const cHi = Math.min(Kc, Math.floor(melIndex[melIndex.length - 1] / m.content_stride) + m.window_future + 1);
-      const melLo = Math.max(0, cLo * m.content_stride - MEL_CONTEXT);
-      const melHi = Math.min(K, Math.max(cHi * m.content_stride, melIndex[melIndex.length - 1] + 1) + MEL_CONTEXT);
-      let t = performance.now();
-      const mel = logMelFrames(samples, a, melLo, melHi - melLo);
-      this.times.mel += performance.now() - t;
-
-      t = performance.now();
-      const logits = (await this.content.run({ mel: { data: mel, shape: [1, melHi - melLo, a.n_mels] } })).logits.data;
-      // Content frame j of this run is clip content frame melLo / stride + j (melLo is a multiple of the stride
-      // or 0, so the convolution's stride lines up with the whole-clip computation).
-      const runOffset = melLo / m.content_stride;
-      const post = softmaxRows(logits.slice((cLo - runOffset) * m.content_classes, (cHi - runOffset) * m.content_classes), m.content_classes);
-      const windows = contentWindows(post, melIndex, m, cLo, Kc);
-      this.times.content += performance.now() - t;
-
-      t = performance.now();
-      const tokens = (await this.hierarchical.run({ windows: { data: windows, shape: [melIndex.length, m.window, m.content_classes] } })).tokens.data;
-      this.times.hierarchical += performance.now() - t;
-
-      // Pose: the LSTM advances over every Mel frame up to this chunk's last one, exactly once.
-      t = performance.now();
-      const need = melIndex[melIndex.length - 1] + 1;
-      if (need > lstmDone) {
-        const ctxLo = Math.max(0, lstmDone - MEL_CONTEXT);
-        const ctxHi = Math.min(K, need + MEL_CONTEXT);
-        const melPose = ctxLo >= melLo && ctxHi <= melHi ? mel.subarray((ctxLo - melLo) * a.n_mels, (ctxHi - melLo) * a.n_mels) : logMelFrames(samples, a, ctxLo, ctxHi - ctxLo);
-        const conv = (await this.poseConv.run({ mel: { data: melPose, shape: [1, ctxHi - ctxLo, a.n_mels] } })).conv.data;
-        const fresh = conv.slice((lstmDone - ctxLo) * C, (need - ctxLo) * C);
-        const out = await this.poseLstm.run({
-          conv: { data: fresh, shape: [1, need - lstmDone, C] },
-          h0: { data: h, shape: [1, 1, C] },
-          c0: { data: c, shape: [1, 1, C] },
-        });
-        h = out.hn.data.slice();
-        c = out.cn.data.slice();
-        // Keep only the pose features this and later chunks can still ask for: from this chunk's first
-        // Mel frame, or from where the LSTM stopped if that is earlier (new features start there).
-        const keepFrom = Math.min(melIndex[0], lstmDone);
-        const old = poseFeatures.subarray((keepFrom - poseFeaturesStart) * m.d_model);
-        const merged = new Float32Array(old.length + out.pose_features.data.length);
-        merged.set(old);
-        merged.set(out.pose_features.data, old.length);
-        poseFeaturesStart = keepFrom;
-        poseFeatures = merged;
-        lstmDone = need;
-      }
-      const poseToken = new Float32Array(melIndex.length * m.d_model);
-      melIndex.forEach((k, i) => poseToken.set(poseFeatures.subarray((k - poseFeaturesStart) * m.d_model, (k - poseFeaturesStart + 1) * m.d_model), i * m.d_model));
-      this.times.pose += performance.now() - t;
-
-      t = performance.now();
-      const decoded = await this.decode(tokens, poseToken, melIndex.length);
-      this.times.decoder += performance.now() - t;
-
-      t = performance.now();
-      const y = applyPose(this.templateMm, decoded.offsets, decoded.pose, melIndex.length);
-      for (let i = 0; i < y.length; i++) y[i] /= this.mmPerUnit;
-      pose.set(decoded.pose, f0 * 6);
-      if (keep) vertices.set(y, f0 * n * 3);
-      this.times.posing += performance.now() - t;
-      options.onFrames?.(f0, y, decoded.pose);
+      const out = await this.produce(state, f0, f1, samples, 0, samples.length);
+      pose.set(out.pose, f0 * 6);
+      if (keep) vertices.set(out.vertices, f0 * n * 3);
+      unposed?.set(out.unposed, f0 * n * 3);
+      options.onFrames?.(f0, out.vertices, out.pose);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose };
+    return { fps: this.fps, frames: F, vertices, pose, unposed };
+  }
+
+  /** Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. */
+  createStream(onFrames: (first: number, frames: Frames) => void): StreamSession {
+    return new StreamSession(this, onFrames);
+  }
+
+  /** Samples a frame needs before it can be computed exactly (its receptive field's last sample, exclusive). */
+  samplesNeeded(frame: number): number {
+    const a = this.manifest.audio;
+    const m = this.manifest.model.config;
+    const r = this.manifest.receptive_field;
+    const mel = frameToMelIndex(frame, a);
+    const lastContent = Math.floor(mel / m.content_stride) + m.window_future;
+    const lastMel = Math.max(lastContent * m.content_stride + r.content_mel_frames, mel + r.pose_mel_frames);
+    return lastMel * a.hop + a.frame_size / 2;
+  }
+
+  /**
+   * Frames [f0, f1) of a signal of `total` samples (Infinity while streaming), of which `samples` holds
+   * [offset, offset + samples.length). Exact whenever the samples cover every frame's receptive field.
+   * @internal
+   */
+  async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number): Promise<Frames> {
+    const a = this.manifest.audio;
+    const m = this.manifest.model.config;
+    const C = m.pose_channels;
+    const K = Number.isFinite(total) ? melFrameCount(total, a) : Infinity;
+    const Kc = Math.ceil(K / m.content_stride);
+    const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));
+    // Content frames the windows need, and the Mel frames (with context) that produce them.
+    const cLo = Math.max(0, Math.floor(melIndex[0] / m.content_stride) - (m.window - 1 - m.window_future));
+    const cHi = Math.min(Kc, Math.floor(melIndex[melIndex.length - 1] / m.content_stride) + m.window_future + 1);
+    const melLo = Math.max(0, cLo * m.content_stride - MEL_CONTEXT);
+    const melHi = Math.min(K, Math.max(cHi * m.content_stride, melIndex[melIndex.length - 1] + 1) + MEL_CONTEXT);
+    const signalEnd = Number.isFinite(total) ? total : offset + samples.length;
+    let t = performance.now();
+    const mel = logMelFrames(samples, a, melLo, melHi - melLo, undefined, offset, signalEnd);
+    this.times.mel += performance.now() - t;
+
+    t = performance.now();
+    const logits = (await this.content.run({ mel: { data: mel, shape: [1, melHi - melLo, a.n_mels] } })).logits.data;
+    // Content frame j of this run is the clip's content frame melLo / stride + j: melLo is 0 or a multiple
+    // of the stride, so the strided convolution lines up with the whole-clip computation.
+    const runOffset = melLo / m.content_stride;
+    const post = softmaxRows(logits.slice((cLo - runOffset) * m.content_classes, (cHi - runOffset) * m.content_classes), m.content_classes);
+    const windows = contentWindows(post, melIndex, m, cLo, Number.isFinite(Kc) ? Kc : undefined);
+    this.times.content += performance.now() - t;
+
+    t = performance.now();
+    const tokens = (await this.hierarchical.run({ windows: { data: windows, shape: [melIndex.length, m.window, m.content_classes] } })).tokens.data;
+    this.times.hierarchical += performance.now() - t;
+
+    // Pose: the LSTM advances over every Mel frame up to this chunk's last one, exactly once.
+    t = performance.now();
+    const need = melIndex[melIndex.length - 1] + 1;
+    if (need > state.lstmDone) {
+      const ctxLo = Math.max(0, state.lstmDone - MEL_CONTEXT);
+      const ctxHi = Math.min(K, need + MEL_CONTEXT);
+      const melPose = ctxLo >= melLo && ctxHi <= melHi
+        ? mel.subarray((ctxLo - melLo) * a.n_mels, (ctxHi - melLo) * a.n_mels)
+        : logMelFrames(samples, a, ctxLo, ctxHi - ctxLo, undefined, offset, signalEnd);
+      const conv = (await this.poseConv.run({ mel: { data: melPose, shape: [1, ctxHi - ctxLo, a.n_mels] } })).conv.data;
+      const fresh = conv.slice((state.lstmDone - ctxLo) * C, (need - ctxLo) * C);
+      const out = await this.poseLstm.run({
+        conv: { data: fresh, shape: [1, need - state.lstmDone, C] },
+        h0: { data: state.h, shape: [1, 1, C] },
+        c0: { data: state.c, shape: [1, 1, C] },
+      });
+      state.h = out.hn.data.slice();
+      state.c = out.cn.data.slice();
+      // Keep only the pose features this and later chunks can still ask for: from this chunk's first
+      // Mel frame, or from where the LSTM stopped if that is earlier (new features start there).
+      const keepFrom = Math.min(melIndex[0], state.lstmDone);
+      const old = state.poseFeatures.subarray((keepFrom - state.poseFeaturesStart) * m.d_model);
+      const merged = new Float32Array(old.length + out.pose_features.data.length);
+      merged.set(old);
+      merged.set(out.pose_features.data, old.length);
+      state.poseFeaturesStart = keepFrom;
+      state.poseFeatures = merged;
+      state.lstmDone = need;
+    }
+    const poseToken = new Float32Array(melIndex.length * m.d_model);
+    const pf = state.poseFeatures;
+    melIndex.forEach((k, i) => poseToken.set(pf.subarray((k - state.poseFeaturesStart) * m.d_model, (k - state.poseFeaturesStart + 1) * m.d_model), i * m.d_model));
+    this.times.pose += performance.now() - t;
+
+    t = performance.now();
+    const decoded = await this.decode(tokens, poseToken, melIndex.length);
+    this.times.decoder += performance.now() - t;
+
+    t = performance.now();
+    const n3 = this.template.vertexCount * 3;
+    const y = applyPose(this.templateMm, decoded.offsets, decoded.pose, melIndex.length);
+    const unposed = new Float32Array(decoded.offsets.length);
+    for (let i = 0; i < y.length; i++) {
+      y[i] /= this.mmPerUnit;
+      unposed[i] = (this.templateMm[i % n3] + decoded.offsets[i]) / this.mmPerUnit;
+    }
+    this.times.posing += performance.now() - t;
+    return { count: melIndex.length, vertices: y, unposed, pose: decoded.pose };
   }
 
   private async decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
@@ -282,6 +354,14 @@ export class TalkingFaceEngine {
     return this.cpu.decode(tokens, poseToken, frames);
   }
 
+  /** A lost device (driver reset, GPU process crash): carry on with the CPU decoder. */
+  private deviceLost(decoder: GpuDecoder, info: GPUDeviceLostInfo): void {
+    if (this.gpu !== decoder) return;
+    this.gpu = null;
+    this.backend = 'cpu';
+    this.backendReason = `WebGPU device lost (${info.message || info.reason}); using the CPU decoder`;
+  }
+
   /** Switch decoders at run time (the numbers are the same; only speed differs). */
   async setBackend(backend: Backend): Promise<void> {
     if (backend === this.backend) return;
@@ -295,12 +375,102 @@ export class TalkingFaceEngine {
     const support = await detectWebGPU();
     if (!support.adapter) throw new ModelLoadError(`WebGPU is not available: ${support.description}`);
     const device = await requestSharedDevice();
-    this.gpu = new GpuDecoder(device, this.cpu.weights, this.template.adjacency, this.manifest.model.config, 96);
+    const decoder = new GpuDecoder(device, this.cpu.weights, this.template.adjacency, this.manifest.model.config, 96);
+    device.lost.then((info) => this.deviceLost(decoder, info));
+    this.gpu = decoder;
     this.backend = 'webgpu';
     this.backendReason = `WebGPU: ${support.description}`;
   }
 
   resetTimes(): void {
     for (const k of Object.keys(this.times) as (keyof StageTimes)[]) this.times[k] = 0;
+  }
+}
+
+/**
+ * Streaming inference: audio pushed in pieces of any size (an AudioWorklet's 128-sample quanta, a
+ * network stream), frames emitted as soon as every sample of their receptive field has arrived, so
+ * the output equals the offline animation of the same audio. `lookAheadMs` is the audio a frame
+ * waits for beyond its own time; processing time comes on top.
+ */
+export class StreamSession {
+  private buffer = new Float32Array(1 << 16);
+  private offset = 0; // signal index of buffer[0]
+  private received = 0; // samples received so far
+  private next = 0; // next frame to produce
+  private ended = false;
+  private readonly state: ProducerState;
+  private busy: Promise<void> = Promise.resolve();
+
+  constructor(
+    private readonly engine: TalkingFaceEngine,
+    private readonly onFrames: (first: number, frames: Frames) => void,
+  ) {
+    this.state = newProducerState(engine.manifest.model.config.pose_channels);
+  }
+
+  get lookAheadMs(): number {
+    return ((this.engine.samplesNeeded(0) / this.engine.manifest.audio.sample_rate) * 1000);
+  }
+
+  get framesProduced(): number {
+    return this.next;
+  }
+
+  /** Append mono samples at the model's rate; resolves when every frame they make ready has been emitted. */
+  push(samples: Float32Array): Promise<void> {
+    if (this.ended) throw new Error('StreamSession: push() after end()');
+    this.append(samples);
+    return this.schedule(() => this.drain(false));
+  }
+
+  /** No more audio: emit the remaining frames (the end of the clip is zero-padded, as offline). */
+  end(): Promise<void> {
+    this.ended = true;
+    return this.schedule(() => this.drain(true));
+  }
+
+  private schedule(job: () => Promise<void>): Promise<void> {
+    const run = this.busy.then(job);
+    this.busy = run.catch(() => undefined);
+    return run;
+  }
+
+  private append(samples: Float32Array): void {
+    const used = this.received - this.offset;
+    if (used + samples.length > this.buffer.length) {
+      const bigger = new Float32Array(Math.max(2 * this.buffer.length, used + samples.length));
+      bigger.set(this.buffer.subarray(0, used));
+      this.buffer = bigger;
+    }
+    this.buffer.set(samples, used);
+    this.received += samples.length;
+  }
+
+  private async drain(final: boolean): Promise<void> {
+    const e = this.engine;
+    const total = final ? this.received : Infinity;
+    const last = final ? e.frameCount(this.received) : Infinity;
+    let f1 = this.next;
+    while (f1 < last && (final || e.samplesNeeded(f1) <= this.received)) f1++;
+    for (let f0 = this.next; f0 < f1; f0 += 96) {
+      const to = Math.min(f1, f0 + 96);
+      const view = this.buffer.subarray(0, this.received - this.offset);
+      const out = await e.produce(this.state, f0, to, view, this.offset, total);
+      this.next = to;
+      this.onFrames(f0, out);
+    }
+    this.trim();
+  }
+
+  /** Forget audio no future frame can read (its receptive field starts at most ~48 Mel frames back). */
+  private trim(): void {
+    const a = this.engine.manifest.audio;
+    const keepFrom = Math.max(0, (frameToMelIndex(this.next, a) - 48) * a.hop - a.frame_size);
+    if (keepFrom - this.offset > this.buffer.length / 2) {
+      const drop = keepFrom - this.offset;
+      this.buffer.copyWithin(0, drop, this.received - this.offset);
+      this.offset = keepFrom;
+    }
   }
 }

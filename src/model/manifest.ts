@@ -42,6 +42,7 @@ export interface Manifest {
   sha256: Record<string, string>;
   decoder_tensors: Record<string, number[]>;
   fixtures: { file: string; frames: number; token_frames: number };
+  receptive_field: { content_mel_frames: number; pose_mel_frames: number };
   look_ahead_ms: number;
 }
 

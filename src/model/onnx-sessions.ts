@@ -25,6 +25,8 @@ export function loadOrt(): Promise<typeof Ort> {
     const isolated = Boolean((globalThis as { crossOriginIsolated?: boolean }).crossOriginIsolated);
     const cores = (globalThis.navigator as Navigator | undefined)?.hardwareConcurrency ?? 1;
     ort.env.wasm.numThreads = isolated ? Math.max(1, Math.min(4, cores)) : 1;
+    // onnxruntime reports node placement notes as warnings through console.error; keep real errors only.
+    ort.env.logLevel = 'error';
     // The runtime files are served next to the app (vite.config.ts copies them to ort/).
     ort.env.wasm.wasmPaths = new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href;
     return ort;

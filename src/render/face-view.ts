@@ -15,6 +15,7 @@ const EYE_COLOR = 0xf4f1ec;
 const IRIS_COLOR = 0x3b2a1e;
 const MOUTH_COLOR = 0x2a0a0c;
 const LIP_COLOR = 0xb8676a;
+const scratchAxis = new THREE.Vector3();
 
 export class FaceView {
   readonly renderer: THREE.WebGLRenderer;
@@ -87,6 +88,15 @@ export class FaceView {
     (this.positions.array as Float32Array).set(vertices);
     this.positions.needsUpdate = true;
     this.face.geometry.computeVertexNormals();
+    this.requestRender();
+  }
+
+  /** Head pose y = R x + t: axis-angle (radians) and translation (template units), applied to face, eyes and mouth. */
+  setPose(rx: number, ry: number, rz: number, tx: number, ty: number, tz: number): void {
+    const angle = Math.hypot(rx, ry, rz);
+    if (angle < 1e-9) this.head.quaternion.identity();
+    else this.head.quaternion.setFromAxisAngle(scratchAxis.set(rx / angle, ry / angle, rz / angle), angle);
+    this.head.position.set(tx, ty, tz);
     this.requestRender();
   }
 

@@ -22,4 +22,9 @@ test('WGSL decoder = TypeScript reference = PyTorch, and the whole engine = PyTo
   expect(r.engineChunkedVsWhole as number).toBeLessThan(1e-5);
   expect(r.engineGpuVsCpu as number).toBeLessThan(1e-5);
   expect(r.engineBackend).toBe('webgpu');
+  // Streaming = offline; frames come out before the stream ends, each waiting for at most 150 ms of audio.
+  expect(r.streamFrames).toBe(18);
+  expect(r.streamFramesBeforeEnd as number).toBeGreaterThan(0);
+  expect(r.streamVsOffline as number).toBeLessThan(1e-5);
+  expect(r.streamLookAheadMs as number).toBeLessThanOrEqual(150);
 });

@@ -44,8 +44,8 @@ test.describe('the face viewer', () => {
     await expect
       .poll(() => page.evaluate(() => (document.getElementById('face-canvas') as HTMLCanvasElement).width))
       .toBeLessThanOrEqual(420 * 2);
-    const s = await imageStats(page, await page.locator('#face-canvas').screenshot());
-    expect(s.foregroundFraction).toBeGreaterThan(0.1);
+    // The face is redrawn on the next animation frame, which can wait while the model loads.
+    await expect.poll(async () => (await imageStats(page, await page.locator('#face-canvas').screenshot())).foregroundFraction).toBeGreaterThan(0.1);
   });
 });
 

@@ -124,7 +124,7 @@ def test_losses_vanish_on_a_perfect_prediction():
     pose = torch.randn(2, 5, 6) * 0.1
     tpl = torch.randn(2, 20, 3)
     y = apply_pose(v, pose)
-    out = {"vertices": y, "pose": pose, "offsets": v - tpl[:, None], "content_logits": torch.zeros(2, 4, 41)}
+    out = {"vertices": y, "unposed": v, "pose": pose, "offsets": v - tpl[:, None], "content_logits": torch.zeros(2, 4, 41)}
     _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), torch.arange(5))
     assert parts["rec"] < 1e-6 and parts["rec_unposed"] < 1e-6 and parts["vel"] < 1e-6 and parts["pose"] < 1e-6
     assert abs(parts["eye"]) < 1e-6

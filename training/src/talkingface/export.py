@@ -121,6 +121,26 @@ def decoder_tensors(model: TalkingFace) -> dict[str, np.ndarray]:
     return t
 
 
+def receptive_field(model: TalkingFace) -> dict:
+    """How many Mel frames past its own position each encoder output reads (the streaming look-ahead):
+    measured, not assumed, by perturbing one Mel frame (at both stride parities) and seeing which outputs move."""
+    cfg = model.cfg
+    K = 200
+    content_reach, pose_reach = 0, 0
+    with torch.no_grad():
+        mel = torch.randn(1, K, model.audio.n_mels)
+        base_c = model.content(mel)
+        base_p = model.pose_encoder.conv(model.pose_encoder.norm(mel).transpose(1, 2))
+        for probe in (60, 61):
+            moved = mel.clone()
+            moved[0, probe] += 1.0
+            c = (model.content(moved) - base_c).abs().amax(-1)[0]
+            p = (model.pose_encoder.conv(model.pose_encoder.norm(moved).transpose(1, 2)) - base_p).abs().amax(1)[0]
+            content_reach = max(content_reach, probe - int(torch.nonzero(c > 0)[0]) * cfg.content_stride)
+            pose_reach = max(pose_reach, probe - int(torch.nonzero(p > 0)[0]))
+    return {"content_mel_frames": content_reach, "pose_mel_frames": pose_reach}
+
+
 def sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
@@ -244,7 +264,9 @@ def export(checkpoint: Path, out: Path) -> dict:
         ]},
         "decoder_tensors": {k: list(v.shape) for k, v in weights.items()},
         "fixtures": fixtures,
-        "look_ahead_ms": round(1000 * (cfg.window_future * cfg.content_stride / a.feature_rate + 0.07 + a.frame_size / 2 / a.sample_rate)),
+        "receptive_field": receptive_field(model),
+        "look_ahead_ms": round(1000 * ((cfg.window_future * cfg.content_stride + receptive_field(model)["content_mel_frames"]) / a.feature_rate
+                                       + a.frame_size / 2 / a.sample_rate)),
     }
     manifest["sha256"] = {name: sha256(out / path) for name, path in all_files.items()}
     manifest["runtime_bytes"] = sum((out / files[n]).stat().st_size for n in runtime)

@@ -18,7 +18,7 @@ class ModelConfig:
     content_classes: int = len(PHONES) + 1  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
     content_channels: int = 128   # content encoder width
     window: int = 16              # W: content frames per animation frame (paper: 16)
-    window_future: int = 6        # of which after the frame: the look-ahead streaming has to wait for
+    window_future: int = 3        # of which after the frame: 3 x 20 ms + the encoder reach (70 ms) + half a frame = 146 ms look-ahead
     content_stride: int = 2       # content frames at feature_rate / stride (100 / 2 = 50 per second, like DeepSpeech)
     pose_channels: int = 128      # pose encoder conv + LSTM width
     global_hidden: int = 128      # hidden size of f_g's MLP

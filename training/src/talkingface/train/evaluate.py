@@ -49,7 +49,22 @@ def evaluate(model, ds, split: str = "test", progress=None) -> dict:
         return {n: float(np.average([r[n] for r in rows], weights=w if n.startswith("E_") or n.startswith("pose_error") else None))
                 for n in names} | {"clips": len(rows)}
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
-            "human": summary([r for r in per_clip if r["source"] == "human"]), "per_clip": per_clip}
+            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t),
+            "per_clip": per_clip}
+
+
+def silence_probe(model, template) -> dict:
+    """Two seconds of digital silence: how far apart does the model leave the inner lips (mm)?
+    The corpus rig closes them in silence (about 0.4 mm, docs/corpus)."""
+    from ..corpus.checks import contour_gap
+    from ..features import log_mel
+    mm = template.to_millimetres()
+    tpl = torch.from_numpy(template.vertices * mm)
+    out = model.animate(torch.from_numpy(log_mel(np.zeros(2 * model.audio.sample_rate, np.float32), model.audio)), tpl, 2 * model.audio.fps)
+    r = template.regions
+    gap = contour_gap(out["unposed"].numpy(), r["lips_inner_upper"], r["lips_inner_lower"])
+    neutral = contour_gap(tpl[None].numpy(), r["lips_inner_upper"], r["lips_inner_lower"])[0]
+    return {"lip_gap_mean_mm": float(gap.mean()), "lip_gap_max_mm": float(gap.max()), "neutral_template_gap_mm": float(neutral)}
 
 
 def main(argv=None) -> int:
@@ -86,7 +101,8 @@ def markdown(res: dict, args, ck: dict) -> str:
         r = res[name]
         if r:
             rows.append(f"| {label} | {r['clips']} | {r['E_vl']:.3f} | {r['E_ve']:.3f} | {r['E_vl_posed']:.3f} | {r['FDD']:.4f} | "
-                        f"{r['AFDD']:.4f} | {r['pose_error_deg']:.2f} | {r['pose_jitter_deg']:.3f} ({r['pose_jitter_gt_deg']:.3f}) |")
+                        f"{r['AFDD']:.4f} | {r['pose_error_deg']:.2f} | {r['pose_jitter_deg']:.3f} ({r['pose_jitter_gt_deg']:.3f}) | "
+                        f"{r['lip_motion_gt']:.2f} / {r['lip_motion_pred']:.2f} |")
     return "\n".join([
         f"# {cfg['features']}+{cfg['decoder']} on the {args.split} split",
         "",
@@ -99,9 +115,14 @@ def markdown(res: dict, args, ck: dict) -> str:
         "Pose error: angle between true and predicted head rotation; jitter: mean second difference of the predicted",
         "rotation per frame (ground truth's in brackets).",
         "",
-        "| clips | n | E_vl | E_ve | E_vl posed | FDD | AFDD | pose error (deg) | jitter (deg) |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| clips | n | E_vl | E_ve | E_vl posed | FDD | AFDD | pose error (deg) | jitter (deg) | lip motion: true / predicted |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
         *rows,
+        "",
+        "Lip motion: mean over frames of the largest lip-vertex displacement from the neutral face.",
+        f"Baseline: a face that never moves scores E_vl {res['all']['E_vl_still_face']:.3f} mm on the same clips.",
+        f"Silence (2 s of zeros): the inner lips are left {res['silence']['lip_gap_mean_mm']:.2f} mm apart on average "
+        f"(at most {res['silence']['lip_gap_max_mm']:.2f}; the neutral template: {res['silence']['neutral_template_gap_mm']:.2f}).",
         "",
     ])
 

@@ -66,10 +66,19 @@ def jitter_deg(pose: np.ndarray) -> float:
     return float(np.degrees(np.linalg.norm(np.diff(pose[:, :3], 2, axis=0), axis=1)).mean())
 
 
+def lip_motion(unposed: np.ndarray, template_mm: np.ndarray, lips: np.ndarray) -> float:
+    """Mean over frames of the largest lip-vertex displacement from the neutral face (how much the mouth moves)."""
+    return float(np.linalg.norm(unposed[:, lips] - template_mm[lips], axis=-1).max(1).mean())
+
+
 def clip_metrics(gt_unposed, pred_unposed, gt_posed, pred_posed, template_mm, gt_pose, pred_pose, regions) -> dict:
     lips, eyes, upper = regions
     return {
+        "lip_motion_gt": lip_motion(gt_unposed, template_mm, lips),
+        "lip_motion_pred": lip_motion(pred_unposed, template_mm, lips),
         "E_vl": max_region_error(gt_unposed, pred_unposed, lips),
+        # The same for a face that never moves: the baseline E_vl must beat.
+        "E_vl_still_face": max_region_error(gt_unposed, np.broadcast_to(template_mm, gt_unposed.shape), lips),
         "E_ve": max_region_error(gt_unposed, pred_unposed, eyes),
         "E_vl_posed": max_region_error(gt_posed, pred_posed, lips),
         "FDD": fdd(gt_unposed - template_mm, pred_unposed - template_mm, upper),

@@ -1,0 +1,80 @@
+/**
+ * npm run bench: the engine's speed and memory on this machine, in headless Chromium.
+ * Builds the app, serves it, opens dev/bench.html, and writes docs/results/bench.json plus a table.
+ * WebGPU here is SwiftShader (software): its figures are reported, not GPU figures.
+ *
+ *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]
+ */
+import { chromium } from '@playwright/test';
+import { spawn, execSync } from 'node:child_process';
+import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { CHROMIUM_ARGS } from '../playwright.config';
+
+const ROOT = resolve(import.meta.dirname, '..');
+const args = process.argv.slice(2);
+const opt = (name: string, fallback: string) => {
+  const i = args.indexOf(name);
+  return i >= 0 ? args[i + 1] : fallback;
+};
+const seconds = opt('--seconds', '10,60').split(',').map(Number);
+const backends = opt('--backends', 'cpu,webgpu').split(',');
+const PORT = 4191;
+
+async function main(): Promise<void> {
+  execSync('npx vite build --logLevel warn', { cwd: ROOT, stdio: 'inherit' });
+  const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
+  try {
+    for (let i = 0; ; i++) {
+      try {
+        if ((await fetch(`http://127.0.0.1:${PORT}/dev/bench.html`)).ok) break;
+      } catch {
+        if (i > 100) throw new Error('the preview server did not start');
+        await new Promise((r) => setTimeout(r, 200));
+      }
+    }
+    const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
+    const page = await browser.newPage();
+    page.on('pageerror', (e) => console.error(`page error: ${e.message}`));
+    await page.goto(`http://127.0.0.1:${PORT}/dev/bench.html`);
+    await page.waitForFunction(() => document.body.dataset.ready === 'true');
+    const wav = readFileSync(resolve(ROOT, 'tests/fixtures/speech-kal.wav')).toString('base64');
+    const t0 = Date.now();
+    const result = (await page.evaluate(
+      ([w, b, s]) => (globalThis as unknown as { runBench: (w: string, b: string[], s: number[]) => Promise<Record<string, unknown>> }).runBench(w, b, s),
+      [wav, backends, seconds] as const,
+    )) as Record<string, unknown>;
+    await browser.close();
+    if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
+    result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
+    mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
+    writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
+    print(result);
+  } finally {
+    try {
+      process.kill(-server.pid!);
+    } catch {
+      /* already gone */
+    }
+  }
+}
+
+function print(r: Record<string, unknown>): void {
+  const runs = r.runs as Record<string, { wall_ms: number; rtf: number; first_frame_ms: number; peak_heap_bytes: number; stages_ms: Record<string, number> }>;
+  const f = (x: number | undefined, d = 1) => (x === undefined ? '-' : x.toFixed(d));
+  console.log('\nrun            wall (ms)   RTF (x real time)   first frame (ms)   peak heap (MB)   mel / content / hier / pose / decoder / posing (ms)');
+  for (const [name, v] of Object.entries(runs)) {
+    const s = v.stages_ms;
+    console.log(`${name.padEnd(14)} ${f(v.wall_ms, 0).padStart(9)}   ${f(v.rtf, 2).padStart(17)}   ${f(v.first_frame_ms, 0).padStart(16)}   ${f(v.peak_heap_bytes / 1e6).padStart(14)}   ` +
+      [s.mel, s.content, s.hierarchical, s.pose, s.decoder, s.posing].map((x) => f(x, 0)).join(' / '));
+  }
+  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms`);
+  console.log(`streaming latency ${f(r.stream_latency_ms as number, 0)} ms = look-ahead ${f(r.stream_look_ahead_ms as number, 0)} + processing p50 ${f(r.stream_processing_p50_ms as number, 0)} (p95 ${f(r.stream_processing_p95_ms as number, 0)})`);
+  console.log('decoder time per frame by vertex count:', JSON.stringify(r.attention_by_vertices));
+  console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
+}
+
+main().catch((e) => {
+  console.error(`bench: ${(e as Error).message}`);
+  process.exit(1);
+});

@@ -1,0 +1,62 @@
+/**
+ * Audio in: any file the browser can decode (wav, mp3, ogg/opus, webm, m4a where supported), a Blob,
+ * or an AudioBuffer -> mono Float32Array at the model's sample rate. Mixing and resampling are done by
+ * an OfflineAudioContext (down-mix to one channel, then the browser's resampler). Library code: Web Audio,
+ * no DOM.
+ */
+
+export class AudioDecodeError extends Error {
+  override name = 'AudioDecodeError';
+}
+
+export interface DecodedAudio {
+  samples: Float32Array; // mono, at `sampleRate`
+  sampleRate: number;
+  /** The decoded original, for playback at full quality. */
+  buffer: AudioBuffer;
+  /** What the input was, for messages: original rate, channels, duration. */
+  source: { sampleRate: number; channels: number; seconds: number };
+}
+
+export async function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
+  let buffer: AudioBuffer;
+  if (input instanceof AudioBuffer) buffer = input;
+  else {
+    const bytes = input instanceof Blob ? await input.arrayBuffer() : input;
+    if (bytes.byteLength === 0) throw new AudioDecodeError('the file is empty');
+    // decodeAudioData needs a context; a one-sample offline context decodes without touching the speakers.
+    const ctx = new OfflineAudioContext(1, 1, 44100);
+    try {
+      buffer = await ctx.decodeAudioData(bytes.slice(0));
+    } catch (e) {
+      throw new AudioDecodeError(`this browser cannot decode the file (unsupported format or corrupt data): ${(e as Error).message || 'decode failed'}`);
+    }
+  }
+  if (buffer.length === 0) throw new AudioDecodeError('the audio has no samples');
+  const source = { sampleRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration };
+  if (buffer.numberOfChannels === 1 && buffer.sampleRate === sampleRate) {
+    return { samples: buffer.getChannelData(0).slice(), sampleRate, buffer, source };
+  }
+  const frames = Math.max(1, Math.round(buffer.duration * sampleRate));
+  const offline = new OfflineAudioContext(1, frames, sampleRate);
+  const node = offline.createBufferSource();
+  node.buffer = buffer;
+  node.connect(offline.destination); // one output channel: the browser down-mixes (speakers rule, (L + R) / 2)
+  node.start();
+  const rendered = await offline.startRendering();
+  return { samples: rendered.getChannelData(0).slice(), sampleRate, buffer, source };
+}
+
+/** Peak level and the share of samples at full scale, for warnings about silence and clipping. */
+export function levels(samples: Float32Array): { peak: number; rms: number; clipped: number } {
+  let peak = 0;
+  let sum = 0;
+  let clipped = 0;
+  for (let i = 0; i < samples.length; i++) {
+    const a = Math.abs(samples[i]);
+    peak = Math.max(peak, a);
+    sum += a * a;
+    if (a >= 0.999) clipped++;
+  }
+  return { peak, rms: Math.sqrt(sum / Math.max(1, samples.length)), clipped: clipped / Math.max(1, samples.length) };
+}

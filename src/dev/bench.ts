@@ -1,0 +1,141 @@
+/**
+ * Benchmark page (dev/bench.html), driven by scripts/bench.ts in headless Chromium. Measures the engine
+ * on this machine and leaves the figures in globalThis.benchResult; nothing here asserts a speed.
+ */
+import { TalkingFaceEngine, type Backend } from '../engine/engine';
+import { decodeAudio } from '../audio/decode';
+import { ReferenceDecoder } from '../attention/reference';
+import { GpuDecoder } from '../attention/gpu-decoder';
+import { requestSharedDevice, detectWebGPU } from '../gpu/capabilities';
+import { buildAdjacency } from '../template/mesh-topology';
+
+const now = () => performance.now();
+const heap = () => (performance as unknown as { memory?: { usedJSHeapSize: number } }).memory?.usedJSHeapSize ?? 0;
+
+/** The speech fixture repeated to `seconds` (real speech, so every stage does real work). */
+function speechOf(seconds: number, clip: Float32Array, rate: number): Float32Array {
+  const out = new Float32Array(Math.round(seconds * rate));
+  for (let i = 0; i < out.length; i += clip.length) out.set(clip.subarray(0, Math.min(clip.length, out.length - i)), i);
+  return out;
+}
+
+/** A triangulated grid (rows x cols) plus `extra` lone vertices: an N-vertex mesh for scaling the attention. */
+function gridAdjacency(rows: number, cols: number, extra: number) {
+  const tris: number[] = [];
+  for (let r = 0; r + 1 < rows; r++)
+    for (let c = 0; c + 1 < cols; c++) {
+      const a = r * cols + c;
+      tris.push(a, a + 1, a + cols + 1, a, a + cols + 1, a + cols);
+    }
+  return buildAdjacency(rows * cols + extra, Uint32Array.from(tris));
+}
+
+async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: number[]): Promise<Record<string, unknown>> {
+  const result: Record<string, unknown> = { userAgent: navigator.userAgent, crossOriginIsolated };
+  const gpu = await detectWebGPU();
+  result.adapter = gpu.info;
+
+  let t = now();
+  const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
+  result.model_load_ms = now() - t;
+  const bytes = await Promise.all(engine.manifest.runtime_files.map(async (k) => (await fetch(`/models/${engine.manifest.files[k]}`)).arrayBuffer()));
+  result.model_bytes = bytes.reduce((s, b) => s + b.byteLength, 0);
+  const rate = engine.manifest.audio.sample_rate;
+  const wav = await decodeAudio(wavBytes, rate);
+
+  const stages: Record<string, unknown> = {};
+  for (const backend of backends) {
+    if (backend === 'webgpu' && !gpu.adapter) continue;
+    await engine.setBackend(backend);
+    for (const seconds of clipSeconds) {
+      if (backend === 'webgpu' && seconds > 10 && gpu.info?.isFallbackAdapter) continue; // software GPU: 10 s is enough to report
+      const audio = speechOf(seconds, wav.samples, rate);
+      engine.resetTimes();
+      let first = -1;
+      let peak = heap();
+      t = now();
+      await engine.animate(audio, {
+        keep: false,
+        onFrames: () => {
+          if (first < 0) first = now() - t;
+          peak = Math.max(peak, heap());
+        },
+      });
+      const wall = now() - t;
+      stages[`${backend}_${seconds}s`] = { wall_ms: wall, rtf: seconds / (wall / 1000), first_frame_ms: first, peak_heap_bytes: peak, stages_ms: { ...engine.times } };
+      result[`rtf_${backend === 'webgpu' ? 'webgpu' : 'cpu'}_${seconds}s`] = seconds / (wall / 1000);
+      if (backend === 'cpu' && seconds === clipSeconds[0]) result.first_frame_ms = first;
+    }
+  }
+  result.runs = stages;
+
+  // Decode time per frame against the vertex count (decoder weights do not depend on N).
+  const m = engine.manifest.model.config;
+  const weights = engine.decoderWeights;
+  const meshes: Record<string, ReturnType<typeof gridAdjacency>> = {
+    '468': engine.template.adjacency,
+    '1790': gridAdjacency(34, 52, 22),
+    '5023': gridAdjacency(31, 162, 1),
+  };
+  const scaling: Record<string, unknown> = {};
+  for (const [label, adjacency] of Object.entries(meshes)) {
+    const n = adjacency.offsets.length - 1;
+    const frames = 8;
+    const tokens = Float32Array.from({ length: frames * n * m.d_model }, (_, i) => Math.sin(i * 0.37));
+    const poseTok = Float32Array.from({ length: frames * m.d_model }, (_, i) => Math.cos(i * 0.11));
+    const cpu = new ReferenceDecoder(weights, adjacency, m);
+    t = now();
+    cpu.decode(tokens, poseTok, frames);
+    const row: Record<string, number> = { cpu_ms_per_frame: (now() - t) / frames };
+    if (gpu.adapter && backends.includes('webgpu')) {
+      const dec = new GpuDecoder(await requestSharedDevice(), weights, adjacency, m, frames);
+      await dec.decode(tokens, poseTok, frames); // warm-up: pipeline compilation
+      t = now();
+      await dec.decode(tokens, poseTok, frames);
+      row.webgpu_ms_per_frame = (now() - t) / frames;
+      dec.destroy();
+    }
+    scaling[label] = row;
+  }
+  result.attention_by_vertices = scaling;
+
+  // Streaming: 10 ms pieces pushed at real-time pace; latency = the audio a frame waits for (look-ahead)
+  // plus the time from the piece that completes its receptive field to the frame's emission.
+  await engine.setBackend('cpu');
+  const audio = speechOf(6, wav.samples, rate);
+  const piece = rate / 100;
+  const delays: number[] = [];
+  let lastPush = 0;
+  const stream = engine.createStream((_, frames) => {
+    for (let i = 0; i < frames.count; i++) delays.push(now() - lastPush);
+  });
+  const startWall = now();
+  for (let i = 0; i < audio.length; i += piece) {
+    const due = startWall + (i / rate) * 1000;
+    const wait = due - now();
+    if (wait > 0) await new Promise((r) => setTimeout(r, wait));
+    lastPush = now();
+    await stream.push(audio.subarray(i, i + piece));
+  }
+  await stream.end();
+  delays.sort((a, b) => a - b);
+  const processing = delays[Math.floor(delays.length * 0.5)];
+  result.stream_look_ahead_ms = stream.lookAheadMs;
+  result.stream_processing_p50_ms = processing;
+  result.stream_processing_p95_ms = delays[Math.floor(delays.length * 0.95)];
+  result.stream_latency_ms = stream.lookAheadMs + processing;
+  return result;
+}
+
+/** Called by scripts/bench.ts with a speech recording (base64 WAV). */
+Object.assign(globalThis, {
+  runBench: async (wavBase64: string, backends: Backend[], seconds: number[]) => {
+    const bytes = Uint8Array.from(atob(wavBase64), (c) => c.charCodeAt(0));
+    try {
+      return await run(bytes.buffer, backends, seconds);
+    } catch (e) {
+      return { error: (e as Error).message, stack: (e as Error).stack };
+    }
+  },
+});
+document.body.dataset.ready = 'true';
