@@ -81,7 +81,7 @@ async function animateFile(file: File): Promise<void> {
     take = { animation, buffer: audio.buffer, name: file.name };
     Object.assign(globalThis, { talkingFace: { ...(globalThis as unknown as { talkingFace: object }).talkingFace, take } });
     const src = audio.source;
-    clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels`}, ${src.sampleRate} Hz`;
+    clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}`;
     showStatus(`Animated ${animation.frames} frames in ${seconds.toFixed(1)} s (${(src.seconds / seconds).toFixed(1)}x real time, decoder: ${engine.backend}).` +
       (notes.length ? ` Note: ${notes.join('; ')}.` : ''));
     playButton.disabled = false;

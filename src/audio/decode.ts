@@ -14,8 +14,9 @@ export interface DecodedAudio {
   sampleRate: number;
   /** The decoded original, for playback at full quality. */
   buffer: AudioBuffer;
-  /** What the input was, for messages: original rate, channels, duration. */
-  source: { sampleRate: number; channels: number; seconds: number };
+  /** What the input was, for messages: channels and duration (decodeAudioData resamples to its context's
+   * rate, so the file's own rate is not known here; decodedRate is that context rate). */
+  source: { decodedRate: number; channels: number; seconds: number };
 }
 
 export async function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
@@ -33,7 +34,7 @@ export async function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampl
     }
   }
   if (buffer.length === 0) throw new AudioDecodeError('the audio has no samples');
-  const source = { sampleRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration };
+  const source = { decodedRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration };
   if (buffer.numberOfChannels === 1 && buffer.sampleRate === sampleRate) {
     return { samples: buffer.getChannelData(0).slice(), sampleRate, buffer, source };
   }
