@@ -66,7 +66,7 @@ def read_safetensors(path: Path) -> dict[str, np.ndarray]:
             continue
         dt = {"F32": "<f4", "I64": "<i8", "I32": "<i4", "U32": "<u4"}[spec["dtype"]]
         a, b = spec["data_offsets"]
-        out[name] = np.frombuffer(raw[8 + n + a : 8 + n + b], dtype=dt).reshape(spec["shape"])
+        out[name] = np.frombuffer(raw[8 + n + a : 8 + n + b], dtype=dt).reshape(spec["shape"]).copy()  # writable
     return out
 
 
