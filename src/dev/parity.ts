@@ -5,7 +5,7 @@
  */
 import { checkManifest } from '../model/manifest';
 import { parseSafetensors, f32 } from '../model/safetensors';
-import { loadTemplate } from '../template/face-template';
+import { MM_PER_UNIT, loadTemplate } from '../template/face-template';
 import { ReferenceDecoder, decoderWeights } from '../attention/reference';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
@@ -48,7 +48,7 @@ async function main() {
   // The whole engine (meyda Mel, ONNX encoders on onnxruntime-web, decoder, posing) on the fixture clip,
   // against PyTorch's vertices, in the template's units; in one chunk and in chunks of 5 frames.
   const audio = f32(fx, 'audio');
-  const mmPerUnit = { mm: 1, cm: 10, m: 1000 }[template.units];
+  const mmPerUnit = MM_PER_UNIT[template.units];
   const torchVertices = Float32Array.from(f32(fx, 'vertices'), (v) => v / mmPerUnit);
   const engine = await TalkingFaceEngine.load({ backend: 'cpu', onnxProviders: ['wasm'] });
   const whole = await engine.animate(audio);

@@ -17,7 +17,7 @@ import { logMelFrames, melFrameCount } from '../audio/mel';
 import { ReferenceDecoder, applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
-import { loadTemplate, type FaceTemplate } from '../template/face-template';
+import { MM_PER_UNIT, loadTemplate, type FaceTemplate } from '../template/face-template';
 
 export type Backend = 'webgpu' | 'cpu';
 
@@ -117,7 +117,7 @@ export class TalkingFaceEngine {
     this.gpu = gpu;
     this.backend = gpu ? 'webgpu' : 'cpu';
     this.backendReason = backendReason;
-    this.mmPerUnit = { mm: 1, cm: 10, m: 1000 }[template.units];
+    this.mmPerUnit = MM_PER_UNIT[template.units];
     this.templateMm = Float32Array.from(template.positions, (v) => v * this.mmPerUnit);
   }
 

@@ -13,6 +13,9 @@
 import { buildAdjacency, type Adjacency } from './mesh-topology';
 
 export const TEMPLATE_FORMAT = 'talking-face-template';
+
+/** Millimetres per template unit (the model works in mm). */
+export const MM_PER_UNIT: Record<'cm' | 'mm' | 'm', number> = { mm: 1, cm: 10, m: 1000 };
 export const TEMPLATE_FORMAT_VERSION = 1;
 
 /** Region names every template must provide (the rig, the metrics and the viewer use them). */

@@ -231,7 +231,7 @@ def export(checkpoint: Path, out: Path) -> dict:
     write_safetensors(out / "gava.safetensors", weights)
     files["decoder_weights"] = "gava.safetensors"
 
-    template_mm = (template.vertices * {"mm": 1.0, "cm": 10.0, "m": 1000.0}[template.units]).astype(np.float32)
+    template_mm = (template.vertices * template.to_millimetres()).astype(np.float32)
     fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures")
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}

@@ -30,6 +30,7 @@ REQUIRED_REGIONS = (
     "jaw",
 )
 _DTYPES = {"float32": np.float32, "uint32": np.uint32}
+MM_PER_UNIT = {"mm": 1.0, "cm": 10.0, "m": 1000.0}  # template and dataset length units
 
 
 class TemplateFormatError(ValueError):
@@ -62,7 +63,7 @@ class Template:
 
     def to_millimetres(self) -> float:
         """Factor that converts this template's units to mm (metrics are reported in mm, as in the paper)."""
-        return {"mm": 1.0, "cm": 10.0, "m": 1000.0}[self.units]
+        return MM_PER_UNIT[self.units]
 
 
 def build_adjacency(num_vertices: int, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

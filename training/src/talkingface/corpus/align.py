@@ -15,6 +15,7 @@ import subprocess
 import numpy as np
 
 from .phonemes import PHONES, SILENCE, normalise_phone
+from .speech import merge_silences
 
 ALIGN_RATE = 16000  # the en-us acoustic model's sample rate
 _FRAME = 0.01       # pocketsphinx frame shift, s
@@ -117,10 +118,4 @@ def _tidy(phones, duration: float) -> list[tuple[str, float, float]]:
             out.append((SILENCE, t, a))
         out.append((p, a, b))
         t = b
-    merged: list[tuple[str, float, float]] = []
-    for p, a, b in out:
-        if merged and p == SILENCE and merged[-1][0] == SILENCE:
-            merged[-1] = (SILENCE, merged[-1][1], b)
-        else:
-            merged.append((p, a, b))
-    return merged
+    return merge_silences(out)

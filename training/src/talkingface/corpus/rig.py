@@ -190,23 +190,3 @@ class Rig:
         meet_z = 0.5 * (zu + zl)
         v[:, 1] += amount * gap * (-upper_share * w_up + (1.0 - upper_share) * w_lo)
         v[:, 2] += amount * ((meet_z - zu) * w_up + (meet_z - zl) * w_lo)
-
-    def lip_gap(self, frames: np.ndarray) -> np.ndarray:
-        """(F, N, 3) -> (F,) largest vertical gap between the inner lips, measured at the upper contour's vertices
-        (away from the corners, where the lips always meet)."""
-        inner = self.upper_lip[1:-1]
-        out = np.empty(len(frames))
-        for f, v in enumerate(frames):
-            yl = np.interp(v[inner, 0], v[self.lower_lip, 0], v[self.lower_lip, 1])
-            out[f] = np.max(v[inner, 1] - yl)
-        return out
-
-    def eye_gap(self, frames: np.ndarray) -> np.ndarray:
-        """(F, N, 3) -> (F,) mean over both eyes of the largest lid opening."""
-        out = np.zeros(len(frames))
-        for up, lo, _, _ in self.eyes:
-            inner = up[1:-1]
-            for f, v in enumerate(frames):
-                yl = np.interp(v[inner, 0], v[lo, 0], v[lo, 1])
-                out[f] += np.max(v[inner, 1] - yl) / len(self.eyes)
-        return out

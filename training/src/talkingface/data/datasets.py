@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..template import Template, load_template
+from ..template import MM_PER_UNIT, Template, load_template
 
 CORPUS_FORMAT = "talking-face-corpus"
 
@@ -138,7 +138,7 @@ def _open_corpus(root: Path) -> FaceDataset:
         raise DatasetError(f"{root}/meta.json is not a {CORPUS_FORMAT} file")
     tpl = load_template(root / "template" / "template.json")
     splits = json.loads((root / "splits.json").read_text())
-    mm = {"mm": 1.0, "cm": 10.0, "m": 1000.0}[meta["units"]]
+    mm = MM_PER_UNIT[meta["units"]]
     return FaceDataset(root, "corpus", tpl, float(meta["fps"]), mm, splits, _read_templates_pkl(root), meta)
 
 

@@ -28,11 +28,7 @@ from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from .data import mel_statistics, prepare, sample_batch
 from .losses import LossWeights, total_loss
-
-
-def eye_indices(template) -> torch.Tensor:
-    r = template.regions
-    return torch.from_numpy(np.unique(np.concatenate([r[f"eye_{s}_{p}"] for s in ("left", "right") for p in ("upper", "lower")])))
+from .metrics import eye_region
 
 
 def load_checkpoint(path: Path, template=None):
@@ -119,7 +115,7 @@ def main(argv=None) -> int:
     net = torch.nn.parallel.DistributedDataParallel(model) if distributed else model
     log(f"{count_parameters(model):,} parameters ({count_parameters(model) * 4 / 1e6:.2f} MB float32)")
 
-    eye = eye_indices(ds.template)
+    eye = torch.from_numpy(eye_region(ds.template))
     rng = np.random.default_rng(args.seed * 1000 + rank + step)
     budget_steps = args.steps
     total_est = budget_steps or 0
