@@ -1,12 +1,13 @@
 /**
  * Test page (dev/parity.html, loaded by tests/e2e/engine-parity.spec.ts): runs the TypeScript reference
- * decoder and the WGSL decoder on the exporter's fixture tokens and reports their differences from
+ * decoder, the fast CPU decoder and the WGSL decoder on the exporter's fixture tokens and reports their differences from
  * each other and from PyTorch. Not part of the app.
  */
 import { checkManifest } from '../model/manifest';
 import { parseSafetensors, f32 } from '../model/safetensors';
 import { MM_PER_UNIT, loadTemplate } from '../template/face-template';
 import { ReferenceDecoder, decoderWeights } from '../attention/reference';
+import { FastDecoder } from '../attention/fast-decoder';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
 import { TalkingFaceEngine } from '../engine/engine';
@@ -42,6 +43,9 @@ async function main() {
     result.gpuRepeatable = maxAbsDiff(again.offsets, g.offsets) === 0;
     dec.destroy();
   }
+  const fast = new FastDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
+  result.fastVsCpuOffsets = maxAbsDiff(fast.offsets, cpu.offsets);
+  result.fastVsCpuPose = maxAbsDiff(fast.pose, cpu.pose);
   result.cpuVsTorchOffsets = maxAbsDiff(cpu.offsets, f32(fx, 'offsets'));
   result.cpuVsTorchPose = maxAbsDiff(cpu.pose, f32(fx, 'pose'));
 

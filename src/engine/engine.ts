@@ -3,7 +3,7 @@
  *
  *   samples (mono, manifest rate) -> log-Mel (meyda) -> content encoder (ONNX) -> windows of phone
  *   posteriors -> hierarchical tokens (ONNX) ; log-Mel -> pose conv + LSTM (ONNX, state carried)
- *   -> GAVA decoder (WGSL or TypeScript) -> y = R (I + O) + t  -> frames in the template's units
+ *   -> GAVA decoder (WGSL, or the fast TypeScript decoder on the CPU) -> y = R (I + O) + t  -> frames in the template's units
  *
  * Frames are produced in chunks; every chunk recomputes the Mel and content frames it needs with
  * enough context on each side that the result equals the whole-clip computation exactly, so memory
@@ -14,7 +14,8 @@ import { parseSafetensors } from '../model/safetensors';
 import { OnnxModel, type ExecutionProvider, ModelLoadError } from '../model/onnx-sessions';
 import { contentWindows, softmaxRows } from '../model/windows';
 import { logMelFrames, melFrameCount } from '../audio/mel';
-import { ReferenceDecoder, applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
+import { applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
+import { FastDecoder } from '../attention/fast-decoder';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
 import { MM_PER_UNIT, loadTemplate, type FaceTemplate } from '../template/face-template';
@@ -95,7 +96,7 @@ function newProducerState(channels: number): ProducerState {
 export class TalkingFaceEngine {
   readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
   private gpu: GpuDecoder | null;
-  private readonly cpu: ReferenceDecoder;
+  private readonly cpu: FastDecoder;
   private readonly templateMm: Float32Array;
   private readonly mmPerUnit: number;
   backend: Backend;
@@ -109,7 +110,7 @@ export class TalkingFaceEngine {
     private readonly hierarchical: OnnxModel,
     private readonly poseConv: OnnxModel,
     private readonly poseLstm: OnnxModel,
-    cpu: ReferenceDecoder,
+    cpu: FastDecoder,
     gpu: GpuDecoder | null,
     backendReason: string,
   ) {
@@ -160,7 +161,7 @@ export class TalkingFaceEngine {
       OnnxModel.create({ name: 'pose_lstm', bytes: lstmBytes, inputs: { conv: [1, 'K', m.pose_channels], h0: [1, 1, m.pose_channels], c0: [1, 1, m.pose_channels] } }, providers),
     ]);
     const weights = decoderWeights(parseSafetensors(weightBytes).tensors, m);
-    const cpu = new ReferenceDecoder(weights, template.adjacency, m);
+    const cpu = new FastDecoder(weights, template.adjacency, m);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';
     const wantGpu = options.backend === 'webgpu' || ((options.backend ?? 'auto') === 'auto' && hardwareGpu);

@@ -4,7 +4,7 @@ import { test, expect } from './fixtures';
  * The WGSL GAVA decoder in headless Chromium (WebGPU on SwiftShader, software but exact) against the
  * TypeScript reference and against PyTorch, on the exporter's fixture tokens (dev/parity.html).
  */
-test('WGSL decoder = TypeScript reference = PyTorch, and the whole engine = PyTorch', async ({ page }) => {
+test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the whole engine = PyTorch', async ({ page }) => {
   await page.goto('/dev/parity.html');
   const result = await page.waitForFunction(() => (globalThis as unknown as { parityResult?: unknown }).parityResult, null, { timeout: 60_000 });
   const r = (await result.jsonValue()) as Record<string, number | boolean | string | { architecture: string } | null>;
@@ -13,6 +13,8 @@ test('WGSL decoder = TypeScript reference = PyTorch, and the whole engine = PyTo
   expect(r.gpuVsCpuOffsets as number).toBeLessThan(1e-4);
   expect(r.gpuVsCpuPose as number).toBeLessThan(1e-5);
   expect(r.gpuVsTorchOffsets as number).toBeLessThan(1e-4);
+  expect(r.fastVsCpuOffsets as number).toBeLessThan(1e-4);
+  expect(r.fastVsCpuPose as number).toBeLessThan(1e-5);
   expect(r.cpuVsTorchOffsets as number).toBeLessThan(1e-4);
   expect(r.cpuVsTorchPose as number).toBeLessThan(1e-5);
   expect(r.gpuRepeatable).toBe(true);

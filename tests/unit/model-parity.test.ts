@@ -9,9 +9,10 @@ import { resolve } from 'node:path';
 import * as ort from 'onnxruntime-node';
 import { checkManifest, frameToMelIndex, type Manifest } from '../../src/model/manifest';
 import { parseSafetensors, f32, type Tensor } from '../../src/model/safetensors';
-import { logMel } from '../../src/audio/mel';
+import { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from '../../src/audio/mel';
 import { contentWindows, softmaxRows } from '../../src/model/windows';
-import { ReferenceDecoder, applyPose, decoderWeights } from '../../src/attention/reference';
+import { ReferenceDecoder, applyPose, decoderWeights, gelu } from '../../src/attention/reference';
+import { FastDecoder, geluInPlace, matmulRows } from '../../src/attention/fast-decoder';
 import { decodeTemplate } from '../../src/template/face-template';
 
 const MODELS = resolve(import.meta.dirname, '../..', process.env.MODELS_DIR ?? 'models');
@@ -43,6 +44,24 @@ describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
   it('log-Mel with meyda matches Python', () => {
     const mel = logMel(f32(fx, 'audio'), manifest.audio);
     expect(maxAbsDiff(mel, f32(fx, 'mel'))).toBeLessThan(1e-4);
+  });
+
+  it('the fast log-Mel equals Meyda.extract, on speech, loud noise, silence and a streaming offset', () => {
+    const a = manifest.audio;
+    const speech = f32(fx, 'audio');
+    let seed = 1;
+    const noise = Float32Array.from({ length: 8000 }, () => ((seed = (seed * 16807) % 2147483647) / 2147483647 - 0.5) * 2);
+    for (const x of [speech, noise, new Float32Array(3000)]) {
+      const K = melFrameCount(x.length, a);
+      const fast = logMelFrames(x, a, 0, K);
+      const meyda = logMelFramesMeyda(x, a, 0, K);
+      let rel = 0;
+      for (let i = 0; i < fast.length; i++) rel = Math.max(rel, Math.abs(fast[i] - meyda[i]) / Math.max(1, Math.abs(meyda[i])));
+      expect(rel).toBeLessThan(1e-6);
+    }
+    // A window of the signal with its offset gives the same frames as the whole signal.
+    const part = logMelFrames(speech.subarray(3000, 6000), a, 25, 5, undefined, 3000, speech.length);
+    expect(maxAbsDiff(part, logMelFrames(speech, a, 25, 5))).toBe(0);
   });
 
   it('frame -> Mel index and the content windows match', () => {
@@ -90,5 +109,46 @@ describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
     expect(maxAbsDiff(out.pose, f32(fx, 'pose').subarray(0, out.pose.length))).toBeLessThan(1e-5);
     const y = applyPose(f32(fx, 'template_mm'), out.offsets, out.pose, frames);
     expect(maxAbsDiff(y, f32(fx, 'vertices').subarray(0, y.length))).toBeLessThan(1e-3); // mm: 1e-4 of the template's cm
+  });
+
+  it('the fast CPU decoder matches PyTorch and the reference decoder', async () => {
+    const m = manifest.model.config;
+    const template = await decodeTemplate(JSON.parse(readFileSync(resolve(MODELS, manifest.template.path), 'utf8')), buf(manifest.template.path.replace('.json', '.bin')));
+    const weights = decoderWeights(parseSafetensors(buf(manifest.files.decoder_weights)).tensors, m);
+    const frames = manifest.fixtures.token_frames;
+    const tokens = f32(fx, 'tokens'), poseTok = f32(fx, 'pose_token');
+    const fast = new FastDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
+    const ref = new ReferenceDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
+    expect(maxAbsDiff(fast.offsets, f32(fx, 'offsets').subarray(0, fast.offsets.length))).toBeLessThan(1e-4);
+    expect(maxAbsDiff(fast.pose, f32(fx, 'pose').subarray(0, fast.pose.length))).toBeLessThan(1e-5);
+    expect(maxAbsDiff(fast.offsets, ref.offsets)).toBeLessThan(1e-4);
+    expect(maxAbsDiff(fast.pose, ref.pose)).toBeLessThan(1e-5);
+  });
+});
+
+describe('the fast decoder\'s kernels', () => {
+  it('blocked matrix product equals the plain sum for every remainder of rows and outputs', () => {
+    for (const [rows, outs, cols] of [[1, 1, 3], [2, 4, 5], [3, 6, 7], [5, 9, 16], [8, 3, 32]]) {
+      const W = Float32Array.from({ length: outs * cols }, (_, i) => Math.sin(i * 1.3));
+      const b = Float32Array.from({ length: outs }, (_, i) => i - 1.5);
+      const X = Float32Array.from({ length: rows * cols }, (_, i) => Math.cos(i * 0.7));
+      const out = new Float32Array(rows * outs);
+      matmulRows(W, b, outs, cols, X, rows, out);
+      for (let t = 0; t < rows; t++)
+        for (let o = 0; o < outs; o++) {
+          let s = b[o];
+          for (let i = 0; i < cols; i++) s += W[o * cols + i] * X[t * cols + i];
+          expect(out[t * outs + o]).toBeCloseTo(s, 5);
+        }
+    }
+  });
+
+  it('tabulated GELU equals the erf formula everywhere, including the tails', () => {
+    const xs = Float32Array.from({ length: 20001 }, (_, i) => -10 + i / 1000);
+    const got = xs.slice();
+    geluInPlace(got, got.length);
+    let worst = 0;
+    for (let i = 0; i < xs.length; i++) worst = Math.max(worst, Math.abs(got[i] - gelu(xs[i])));
+    expect(worst).toBeLessThan(5e-7); // the reference's own erf is good to 1.5e-7
   });
 });

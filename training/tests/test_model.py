@@ -125,12 +125,17 @@ def test_losses_vanish_on_a_perfect_prediction():
     tpl = torch.randn(2, 20, 3)
     y = apply_pose(v, pose)
     out = {"vertices": y, "unposed": v, "pose": pose, "offsets": v - tpl[:, None], "content_logits": torch.zeros(2, 4, 41)}
-    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), torch.arange(5))
-    assert parts["rec"] < 1e-6 and parts["rec_unposed"] < 1e-6 and parts["vel"] < 1e-6 and parts["pose"] < 1e-6
+    eye, lips = torch.arange(5), torch.arange(10, 14)
+    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), eye, lips)
+    assert parts["rec"] < 1e-6 and parts["rec_unposed"] < 1e-6 and parts["rec_lips"] < 1e-6 and parts["vel"] < 1e-6 and parts["pose"] < 1e-6
     assert abs(parts["eye"]) < 1e-6
-    out["vertices"] = y + torch.tensor([1.0, 0, 0])  # a posed-only error leaves the unposed term at zero
-    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), torch.arange(5))
-    assert parts["rec"] == pytest.approx(1.0, abs=1e-5) and parts["vel"] < 1e-6
+    out["vertices"] = y + torch.tensor([1.0, 0, 0])  # a posed-only error leaves the unposed terms at zero
+    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), eye, lips)
+    assert parts["rec"] == pytest.approx(1.0, abs=1e-5) and parts["vel"] < 1e-6 and parts["rec_lips"] < 1e-6
+    out["vertices"], out["unposed"] = y, v.clone()
+    out["unposed"][..., 12, :] += torch.tensor([0.0, 2.0, 0.0])  # an error on one lip vertex: 2 mm / 4 lip vertices
+    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), eye, lips)
+    assert parts["rec_lips"] == pytest.approx(0.5, abs=1e-5) and parts["rec_unposed"] == pytest.approx(0.1, abs=1e-5)
 
 
 def test_metrics_on_known_errors(template):

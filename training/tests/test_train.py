@@ -4,6 +4,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import torch
 
 from talkingface.train import evaluate, train
@@ -39,12 +40,13 @@ def test_two_process_ddp_with_gloo(corpus, tmp_path):
     assert ck["world_size"] == 2 and ck["step"] == 2
 
 
-def test_ablation_driver_writes_the_table(corpus, tmp_path):
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_ablation_driver_writes_the_table(corpus, tmp_path, jobs):
     import json
     from talkingface.train import ablation
     out = tmp_path / "results"
     ablation.main(["--corpus", str(corpus.root), "--steps", "1", "--rows", "G+MLP", "LG+GAVA", "--runs", str(tmp_path / "runs"),
-                   "--out", str(out), "--batch-clips", "2", "--frames", "4"])
+                   "--out", str(out), "--batch-clips", "2", "--frames", "4", "--jobs", jobs])
     table = json.loads((out / "ablation.json").read_text())
     for row in ("G+MLP", "LG+GAVA"):
         assert set(("E_vl", "E_ve", "FDD", "AFDD")) <= set(table[row])
