@@ -72,12 +72,13 @@ export default defineConfig({
     target: 'es2022',
     sourcemap: true,
     chunkSizeWarningLimit: 1024,
-    // dev/parity.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
+    // dev/parity.html, dev/live.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
     rolldownOptions: {
       input: {
         main: resolve(import.meta.dirname, 'index.html'),
         parity: resolve(import.meta.dirname, 'dev/parity.html'),
         bench: resolve(import.meta.dirname, 'dev/bench.html'),
+        live: resolve(import.meta.dirname, 'dev/live.html'),
       },
     },
   },

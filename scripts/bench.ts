@@ -10,6 +10,12 @@ import { spawn, execSync } from 'node:child_process';
 import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
+import { checkManifest } from '../src/model/manifest';
+import { parseSafetensors } from '../src/model/safetensors';
+import { decodeTemplate } from '../src/template/face-template';
+import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
+import { FastDecoder } from '../src/attention/fast-decoder';
+import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -21,7 +27,44 @@ const seconds = opt('--seconds', '10,60').split(',').map(Number);
 const backends = opt('--backends', 'cpu,webgpu').split(',');
 const PORT = 4191;
 
+/** The parts of the engine that run the same in Node (no Web Audio, no WebGPU): Mel and the CPU decoders. */
+async function nodeBench(): Promise<Record<string, number>> {
+  const models = resolve(ROOT, 'models');
+  const bytes = (p: string) => {
+    const b = readFileSync(resolve(models, p));
+    return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer;
+  };
+  const manifest = checkManifest(JSON.parse(readFileSync(resolve(models, 'manifest.json'), 'utf8')));
+  const template = await decodeTemplate(JSON.parse(readFileSync(resolve(models, manifest.template.path), 'utf8')), bytes(manifest.template.path.replace('.json', '.bin')));
+  const m = manifest.model.config;
+  const weights = decoderWeights(parseSafetensors(bytes(manifest.files.decoder_weights)).tensors, m);
+  const wav = readFileSync(resolve(ROOT, 'tests/fixtures/speech-kal.wav'));
+  const pcm = new Int16Array(wav.buffer.slice(wav.byteOffset + 44, wav.byteOffset + wav.byteLength - ((wav.byteLength - 44) % 2)));
+  const samples = Float32Array.from(pcm, (v) => v / 32768);
+  const seconds = samples.length / manifest.audio.sample_rate;
+  const time = (fn: () => void, reps = 3) => {
+    fn();
+    const t = performance.now();
+    for (let i = 0; i < reps; i++) fn();
+    return (performance.now() - t) / reps;
+  };
+  const K = melFrameCount(samples.length, manifest.audio);
+  const frames = 30;
+  const n = template.vertexCount;
+  const tokens = Float32Array.from({ length: frames * n * m.d_model }, (_, i) => Math.sin(i * 0.37));
+  const poseTok = Float32Array.from({ length: frames * m.d_model }, (_, i) => Math.cos(i * 0.11));
+  const fast = new FastDecoder(weights, template.adjacency, m);
+  const reference = new ReferenceDecoder(weights, template.adjacency, m);
+  return {
+    mel_ms_per_audio_second: time(() => logMelFrames(samples, manifest.audio, 0, K)) / seconds,
+    mel_meyda_extract_ms_per_audio_second: time(() => logMelFramesMeyda(samples, manifest.audio, 0, K), 1) / seconds,
+    decoder_ms_per_frame: time(() => fast.decode(tokens, poseTok, frames)) / frames,
+    reference_decoder_ms_per_frame: time(() => reference.decode(tokens, poseTok, 4), 1) / 4,
+  };
+}
+
 async function main(): Promise<void> {
+  const node = await nodeBench();
   execSync('npx vite build --logLevel warn', { cwd: ROOT, stdio: 'inherit' });
   const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
   try {
@@ -46,6 +89,7 @@ async function main(): Promise<void> {
     )) as Record<string, unknown>;
     await browser.close();
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
+    result.node = node;
     result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
     mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
     writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
@@ -69,8 +113,12 @@ function print(r: Record<string, unknown>): void {
       [s.mel, s.content, s.hierarchical, s.pose, s.decoder, s.posing].map((x) => f(x, 0)).join(' / '));
   }
   console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms`);
-  console.log(`streaming latency ${f(r.stream_latency_ms as number, 0)} ms = look-ahead ${f(r.stream_look_ahead_ms as number, 0)} + processing p50 ${f(r.stream_processing_p50_ms as number, 0)} (p95 ${f(r.stream_processing_p95_ms as number, 0)})`);
+  console.log(`streaming latency (sample in -> frame out) p50 ${f(r.stream_latency_ms as number, 0)} ms, p95 ${f(r.stream_latency_p95_ms as number, 0)} ms; ` +
+    `of which look-ahead ${f(r.stream_look_ahead_ms as number, 0)} ms, pieces of ${f(r.stream_piece_ms as number, 0)} ms`);
   console.log('decoder time per frame by vertex count:', JSON.stringify(r.attention_by_vertices));
+  const nd = r.node as Record<string, number>;
+  console.log(`Node: Mel ${f(nd.mel_ms_per_audio_second)} ms per audio second (Meyda.extract per frame: ${f(nd.mel_meyda_extract_ms_per_audio_second)}); ` +
+    `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame (reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
   console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
 }
 

@@ -105,31 +105,27 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   }
   result.attention_by_vertices = scaling;
 
-  // Streaming: 10 ms pieces pushed at real-time pace; latency = the audio a frame waits for (look-ahead)
-  // plus the time from the piece that completes its receptive field to the frame's emission.
+  // Streaming: 16 ms pieces (what the capture worklet delivers) pushed at real-time pace. Latency, as
+  // StreamSession measures it: from the arrival of the sample at a frame's instant to the frame's
+  // emission (look-ahead + piece size + processing).
   await engine.setBackend('cpu');
   const audio = speechOf(6, wav.samples, rate);
-  const piece = rate / 100;
-  const delays: number[] = [];
-  let lastPush = 0;
-  const stream = engine.createStream((_, frames) => {
-    for (let i = 0; i < frames.count; i++) delays.push(now() - lastPush);
-  });
+  const piece = Math.round(rate * 0.016);
+  const stream = engine.createStream(() => undefined);
   const startWall = now();
   for (let i = 0; i < audio.length; i += piece) {
-    const due = startWall + (i / rate) * 1000;
+    const due = startWall + ((i + piece) / rate) * 1000; // a piece can be pushed once its last sample exists
     const wait = due - now();
     if (wait > 0) await new Promise((r) => setTimeout(r, wait));
-    lastPush = now();
     await stream.push(audio.subarray(i, i + piece));
   }
+  const lat = stream.latency;
   await stream.end();
-  delays.sort((a, b) => a - b);
-  const processing = delays[Math.floor(delays.length * 0.5)];
   result.stream_look_ahead_ms = stream.lookAheadMs;
-  result.stream_processing_p50_ms = processing;
-  result.stream_processing_p95_ms = delays[Math.floor(delays.length * 0.95)];
-  result.stream_latency_ms = stream.lookAheadMs + processing;
+  result.stream_piece_ms = (piece / rate) * 1000;
+  result.stream_latency_ms = lat.p50Ms;
+  result.stream_latency_p95_ms = lat.p95Ms;
+  result.stream_processing_p50_ms = lat.p50Ms - stream.lookAheadMs;
   return result;
 }
 

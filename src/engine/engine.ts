@@ -17,6 +17,7 @@ import { logMelFrames, melFrameCount } from '../audio/mel';
 import { applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { FastDecoder } from '../attention/fast-decoder';
 import { GpuDecoder } from '../attention/gpu-decoder';
+import { LiveSession, type LiveOptions } from './live';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
 import { MM_PER_UNIT, loadTemplate, type FaceTemplate } from '../template/face-template';
 
@@ -234,6 +235,11 @@ export class TalkingFaceEngine {
     return new StreamSession(this, onFrames);
   }
 
+  /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
+  listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
+    return LiveSession.start(this, media, onFrames, options);
+  }
+
   /** Samples a frame needs before it can be computed exactly (its receptive field's last sample, exclusive). */
   samplesNeeded(frame: number): number {
     const a = this.manifest.audio;
@@ -402,6 +408,9 @@ export class StreamSession {
   private ended = false;
   private readonly state: ProducerState;
   private busy: Promise<void> = Promise.resolve();
+  /** Arrival of recent pushes: the stream's sample count after the push, and the time (ms) it came. */
+  private arrivals: { end: number; time: number }[] = [];
+  private latencies: number[] = [];
 
   constructor(
     private readonly engine: TalkingFaceEngine,
@@ -418,10 +427,27 @@ export class StreamSession {
     return this.next;
   }
 
+  get sampleRate(): number {
+    return this.engine.manifest.audio.sample_rate;
+  }
+
+  /**
+   * Measured latency of the frames emitted so far (the last 300): for each frame, the time from the
+   * arrival of the audio sample at the frame's own instant to the frame's emission, in ms. It holds
+   * the look-ahead, the size of the pieces pushed, and processing; not the audio hardware's own input
+   * latency (an AudioContext's baseLatency), which comes before the samples reach push().
+   */
+  get latency(): { frames: number; lastMs: number; p50Ms: number; p95Ms: number } {
+    const v = [...this.latencies].sort((a, b) => a - b);
+    const at = (q: number) => (v.length ? v[Math.min(v.length - 1, Math.floor(q * v.length))] : NaN);
+    return { frames: this.latencies.length, lastMs: this.latencies[this.latencies.length - 1] ?? NaN, p50Ms: at(0.5), p95Ms: at(0.95) };
+  }
+
   /** Append mono samples at the model's rate; resolves when every frame they make ready has been emitted. */
   push(samples: Float32Array): Promise<void> {
     if (this.ended) throw new Error('StreamSession: push() after end()');
     this.append(samples);
+    this.arrivals.push({ end: this.received, time: performance.now() });
     return this.schedule(() => this.drain(false));
   }
 
@@ -459,9 +485,26 @@ export class StreamSession {
       const view = this.buffer.subarray(0, this.received - this.offset);
       const out = await e.produce(this.state, f0, to, view, this.offset, total);
       this.next = to;
+      if (!final) this.measure(f0, to);
       this.onFrames(f0, out);
     }
     this.trim();
+  }
+
+  /** Record frames [f0, f1)'s latency: now minus the moment the sample at each frame's instant arrived. */
+  private measure(f0: number, f1: number): void {
+    const now = performance.now();
+    const rate = this.engine.manifest.audio.sample_rate;
+    for (let f = f0; f < f1; f++) {
+      const sample = Math.round((f / this.engine.fps) * rate);
+      while (this.arrivals.length > 1 && this.arrivals[0].end <= sample) this.arrivals.shift();
+      const a = this.arrivals[0];
+      if (!a || a.end <= sample) continue;
+      // Pieces arrive when their last sample has been captured: the frame's sample came (end - sample) samples earlier.
+      const captured = a.time - ((a.end - sample) / rate) * 1000;
+      this.latencies.push(now - captured);
+    }
+    if (this.latencies.length > 300) this.latencies.splice(0, this.latencies.length - 300);
   }
 
   /** Forget audio no future frame can read (its receptive field starts at most ~48 Mel frames back). */

@@ -11,14 +11,15 @@ class ModelConfig:
     features: str = "LG"          # hierarchical feature: "G" global only, "L" local only, "LG" both summed (Sec. III-C)
     decoder: str = "GAVA"         # "GAVA" neighbour-masked attention, "SA" unmasked self-attention, "MLP"
     variant: str = "paper"        # "paper": masked attention only; "released": graph-conv Q/K/V + one full-attention layer per block
-    d_model: int = 64             # token size d
+    d_model: int = 32             # token size d (32, not 64: the browser's CPU decoder must run 10x real time on 2 cores, README)
     heads: int = 4                # attention heads (d_k = d_model / heads)
     layers: int = 3               # attention layers (the paper's Fig. 7 reads the third)
-    ffn: int = 128                # feed-forward hidden size
+    ffn: int = 64                 # feed-forward hidden size
     content_classes: int = len(PHONES) + 1  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
     content_channels: int = 128   # content encoder width
     window: int = 16              # W: content frames per animation frame (paper: 16)
-    window_future: int = 3        # of which after the frame: 3 x 20 ms + the encoder reach (70 ms) + half a frame = 146 ms look-ahead
+    window_future: int = 1        # of which after the frame: 1 x 20 ms + the encoder reach (70 ms) + half a Mel frame = 106 ms look-ahead
+                                  # (3 gave 146 ms, leaving no room in the 150 ms streaming budget, README)
     content_stride: int = 2       # content frames at feature_rate / stride (100 / 2 = 50 per second, like DeepSpeech)
     pose_channels: int = 128      # pose encoder conv + LSTM width
     global_hidden: int = 128      # hidden size of f_g's MLP

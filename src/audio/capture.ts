@@ -1,0 +1,192 @@
+/**
+ * Live audio in: a MediaStream (the microphone, or any stream) -> mono Float32Array pieces at the
+ * model's sample rate, as they arrive, through an AudioWorklet. Library code: Web Audio, no DOM.
+ *
+ * The AudioContext runs at the model's rate when the browser allows it (Chromium resamples the
+ * stream for us); otherwise at the device's rate, and a streaming resampler brings the pieces down.
+ * The worklet module is made from a string (a blob: URL), so the library needs no extra file and the
+ * page makes no request for it.
+ */
+
+export class MicrophoneError extends Error {
+  override name = 'MicrophoneError';
+}
+
+/** getUserMedia with messages a person can act on. */
+export async function openMicrophone(): Promise<MediaStream> {
+  if (!globalThis.navigator?.mediaDevices?.getUserMedia) {
+    throw new MicrophoneError('this page cannot use a microphone here (it needs a secure context: https or localhost)');
+  }
+  try {
+    return await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
+  } catch (e) {
+    const name = (e as DOMException).name;
+    if (name === 'NotAllowedError' || name === 'SecurityError') throw new MicrophoneError('microphone access was denied; allow it in the browser (the address bar\'s site settings) and try again, or open an audio file instead');
+    if (name === 'NotFoundError' || name === 'OverconstrainedError') throw new MicrophoneError('no microphone was found; plug one in, or open an audio file instead');
+    if (name === 'NotReadableError' || name === 'AbortError') throw new MicrophoneError('the microphone is in use by another application or could not be started');
+    throw new MicrophoneError(`the microphone could not be opened: ${(e as Error).message || name}`);
+  }
+}
+
+// Posts the mono mix of its input in blocks of `block` samples (128-sample render quanta gathered).
+const WORKLET = `
+class TalkingFaceCapture extends AudioWorkletProcessor {
+  constructor(options) {
+    super();
+    this.block = options.processorOptions.block;
+    this.buffer = new Float32Array(this.block);
+    this.filled = 0;
+    this.running = true;
+    this.port.onmessage = (e) => { if (e.data === 'stop') this.running = false; };
+  }
+  process(inputs) {
+    const input = inputs[0];
+    if (input && input.length > 0) {
+      const n = input[0].length;
+      for (let i = 0; i < n; i++) {
+        let s = 0;
+        for (let c = 0; c < input.length; c++) s += input[c][i];
+        this.buffer[this.filled++] = s / input.length;
+        if (this.filled === this.block) {
+          this.port.postMessage(this.buffer, [this.buffer.buffer]);
+          this.buffer = new Float32Array(this.block);
+          this.filled = 0;
+        }
+      }
+    }
+    return this.running;
+  }
+}
+registerProcessor('talking-face-capture', TalkingFaceCapture);
+`;
+
+/**
+ * Linear-phase low-pass + fractional resampling, streaming: pieces in at `from` Hz, pieces out at
+ * `to` Hz, continuous across pieces. A windowed-sinc kernel (cut-off just under the lower Nyquist).
+ */
+export class StreamResampler {
+  private readonly ratio: number;
+  private readonly half: number;
+  private readonly cutoff: number;
+  private history: Float32Array;
+  private position = 0; // next output time, in input samples from the start of the stream
+  private received = 0; // input samples so far
+
+  constructor(readonly from: number, readonly to: number, taps = 16) {
+    this.ratio = from / to;
+    this.cutoff = Math.min(1, to / from) * 0.95;
+    this.half = Math.ceil(taps / this.cutoff);
+    this.history = new Float32Array(0);
+  }
+
+  /** How long an output sample waits for input past its own time (half the kernel), in seconds. */
+  get delaySeconds(): number {
+    return this.half / this.from;
+  }
+
+  push(input: Float32Array): Float32Array {
+    if (this.from === this.to) return input.slice();
+    // history holds input samples [received - history.length, received).
+    const joined = new Float32Array(this.history.length + input.length);
+    joined.set(this.history);
+    joined.set(input, this.history.length);
+    const base = this.received - this.history.length; // input index of joined[0]
+    this.received += input.length;
+    const out: number[] = [];
+    // An output sample at input time p needs inputs up to p + half.
+    while (this.position + this.half < this.received) {
+      const p = this.position;
+      const centre = Math.floor(p);
+      let s = 0, wsum = 0;
+      for (let k = centre - this.half + 1; k <= centre + this.half; k++) {
+        const x = k - p;
+        const w = sinc(x * this.cutoff) * hann(x / (this.half + 1));
+        wsum += w;
+        const j = k - base;
+        if (k >= 0 && j >= 0 && j < joined.length) s += w * joined[j];
+      }
+      out.push(s / wsum);
+      this.position += this.ratio;
+    }
+    const keepFrom = Math.max(0, Math.floor(this.position) - this.half - base);
+    this.history = joined.slice(keepFrom);
+    return Float32Array.from(out);
+  }
+}
+
+function sinc(x: number): number {
+  if (Math.abs(x) < 1e-9) return 1;
+  const y = Math.PI * x;
+  return Math.sin(y) / y;
+}
+
+function hann(u: number): number {
+  return Math.abs(u) >= 1 ? 0 : 0.5 + 0.5 * Math.cos(Math.PI * u);
+}
+
+export interface CaptureOptions {
+  /** Samples per piece delivered to onSamples, at the model's rate (default 256: 16 ms at 16 kHz). */
+  block?: number;
+  /** Play the stream to the speakers as well (default false: no feedback loop with a microphone). */
+  monitor?: boolean;
+}
+
+/** A running capture: stop() releases the worklet, the context and (if asked) the stream's tracks. */
+export class AudioCapture {
+  private stopped = false;
+
+  private constructor(
+    readonly context: AudioContext,
+    private readonly node: AudioWorkletNode,
+    private readonly source: MediaStreamAudioSourceNode,
+    readonly stream: MediaStream,
+    /** The rate of the pieces handed to onSamples (the model's). */
+    readonly sampleRate: number,
+    /** The rate the context actually runs at. */
+    readonly contextRate: number,
+  ) {}
+
+  static async start(stream: MediaStream, sampleRate: number, onSamples: (samples: Float32Array) => void, options: CaptureOptions = {}): Promise<AudioCapture> {
+    if (stream.getAudioTracks().length === 0) throw new MicrophoneError('the stream has no audio track');
+    let context: AudioContext;
+    let source: MediaStreamAudioSourceNode;
+    try {
+      context = new AudioContext({ sampleRate, latencyHint: 'interactive' });
+      source = context.createMediaStreamSource(stream);
+    } catch {
+      // Some browsers cannot connect a stream to a context at another rate: run at the device's rate.
+      context = new AudioContext({ latencyHint: 'interactive' });
+      source = context.createMediaStreamSource(stream);
+    }
+    const rate = context.sampleRate;
+    const block = Math.max(128, Math.round(((options.block ?? 256) * rate) / sampleRate));
+    const url = URL.createObjectURL(new Blob([WORKLET], { type: 'text/javascript' }));
+    try {
+      await context.audioWorklet.addModule(url);
+    } finally {
+      URL.revokeObjectURL(url);
+    }
+    const node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
+    const resampler = rate === sampleRate ? null : new StreamResampler(rate, sampleRate);
+    node.port.onmessage = (e: MessageEvent<Float32Array>) => {
+      const piece = resampler ? resampler.push(e.data) : e.data;
+      if (piece.length > 0) onSamples(piece);
+    };
+    source.connect(node);
+    if (options.monitor) source.connect(context.destination);
+    if (context.state === 'suspended') await context.resume().catch(() => undefined);
+    return new AudioCapture(context, node, source, stream, sampleRate, rate);
+  }
+
+  /** Stop capturing. `releaseStream` also stops the stream's tracks (the browser's recording indicator goes off). */
+  async stop(releaseStream = true): Promise<void> {
+    if (this.stopped) return;
+    this.stopped = true;
+    this.node.port.postMessage('stop');
+    this.node.port.onmessage = null;
+    this.source.disconnect();
+    this.node.disconnect();
+    if (releaseStream) for (const t of this.stream.getTracks()) t.stop();
+    await this.context.close().catch(() => undefined);
+  }
+}

@@ -1,0 +1,72 @@
+/**
+ * Live animation: a MediaStream (the microphone) -> AudioWorklet capture -> StreamSession -> frames,
+ * as the person speaks. The take is kept (mono, model rate) so it can be replayed or animated again.
+ */
+import { AudioCapture, type CaptureOptions } from '../audio/capture';
+import type { Frames, StreamSession, TalkingFaceEngine } from './engine';
+
+export interface LiveOptions extends CaptureOptions {
+  /** Keep the captured audio for replay (default true). A ten-minute take is 38 MB at 16 kHz. */
+  keepAudio?: boolean;
+  /** Called when processing a piece fails (the session stops). */
+  onError?: (error: Error) => void;
+}
+
+export class LiveSession {
+  private pieces: Float32Array[] = [];
+  private samples = 0;
+  private stopping: Promise<Float32Array> | null = null;
+  private failed: Error | null = null;
+
+  private constructor(
+    readonly stream: StreamSession,
+    private capture: AudioCapture | null,
+    private readonly keepAudio: boolean,
+  ) {}
+
+  static async start(engine: TalkingFaceEngine, media: MediaStream, onFrames: (first: number, frames: Frames) => void, options: LiveOptions = {}): Promise<LiveSession> {
+    const stream = engine.createStream(onFrames);
+    const session = new LiveSession(stream, null, options.keepAudio ?? true);
+    session.capture = await AudioCapture.start(media, engine.manifest.audio.sample_rate, (piece) => session.receive(piece, options.onError), options);
+    return session;
+  }
+
+  /** Seconds of audio captured so far. */
+  get seconds(): number {
+    return this.samples / this.stream.sampleRate;
+  }
+
+  /** The AudioContext's own input latency (s), which comes before the samples reach the engine. */
+  get inputLatencySeconds(): number {
+    return this.capture?.context.baseLatency ?? 0;
+  }
+
+  private receive(piece: Float32Array, onError?: (error: Error) => void): void {
+    if (this.stopping || this.failed) return;
+    this.samples += piece.length;
+    if (this.keepAudio) this.pieces.push(piece);
+    this.stream.push(piece).catch((e: Error) => {
+      if (this.failed) return;
+      this.failed = e;
+      void this.capture?.stop();
+      onError?.(e);
+    });
+  }
+
+  /** Stop capturing, emit the remaining frames, and return the take (empty when keepAudio is false). */
+  stop(): Promise<Float32Array> {
+    this.stopping ??= (async () => {
+      await this.capture?.stop();
+      if (!this.failed) await this.stream.end();
+      const take = new Float32Array(this.keepAudio ? this.samples : 0);
+      let o = 0;
+      for (const p of this.pieces) {
+        take.set(p, o);
+        o += p.length;
+      }
+      this.pieces = [];
+      return take;
+    })();
+    return this.stopping;
+  }
+}
