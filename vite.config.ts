@@ -72,13 +72,14 @@ export default defineConfig({
     target: 'es2022',
     sourcemap: true,
     chunkSizeWarningLimit: 1024,
-    // dev/parity.html, dev/live.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
+    // dev/parity.html, dev/live.html, dev/long.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
     rolldownOptions: {
       input: {
         main: resolve(import.meta.dirname, 'index.html'),
         parity: resolve(import.meta.dirname, 'dev/parity.html'),
         bench: resolve(import.meta.dirname, 'dev/bench.html'),
         live: resolve(import.meta.dirname, 'dev/live.html'),
+        long: resolve(import.meta.dirname, 'dev/long.html'),
       },
     },
   },
