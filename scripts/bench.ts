@@ -65,7 +65,7 @@ async function nodeBench(): Promise<Record<string, number>> {
 
 async function main(): Promise<void> {
   const node = await nodeBench();
-  execSync('npx vite build --logLevel warn', { cwd: ROOT, stdio: 'inherit' });
+  execSync('npm run --silent build', { cwd: ROOT, stdio: 'inherit' });
   const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
   try {
     for (let i = 0; ; i++) {

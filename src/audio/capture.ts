@@ -37,9 +37,17 @@ class TalkingFaceCapture extends AudioWorkletProcessor {
     this.buffer = new Float32Array(this.block);
     this.filled = 0;
     this.running = true;
-    this.port.onmessage = (e) => { if (e.data === 'stop') this.running = false; };
+    // On 'stop': hand over the partial block, then say so; the main thread waits for 'stopped', so
+    // every captured sample reaches it even if it was busy and its message queue is long.
+    this.port.onmessage = (e) => {
+      if (e.data !== 'stop' || !this.running) return;
+      this.running = false;
+      if (this.filled > 0) this.port.postMessage(this.buffer.slice(0, this.filled));
+      this.port.postMessage('stopped');
+    };
   }
   process(inputs) {
+    if (!this.running) return false;
     const input = inputs[0];
     if (input && input.length > 0) {
       const n = input[0].length;
@@ -54,7 +62,7 @@ class TalkingFaceCapture extends AudioWorkletProcessor {
         }
       }
     }
-    return this.running;
+    return true;
   }
 }
 registerProcessor('talking-face-capture', TalkingFaceCapture);
@@ -144,6 +152,7 @@ export class AudioCapture {
     readonly sampleRate: number,
     /** The rate the context actually runs at. */
     readonly contextRate: number,
+    private readonly flushed: { stopped: (() => void) | null },
   ) {}
 
   static async start(stream: MediaStream, sampleRate: number, onSamples: (samples: Float32Array) => void, options: CaptureOptions = {}): Promise<AudioCapture> {
@@ -168,21 +177,37 @@ export class AudioCapture {
     }
     const node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
     const resampler = rate === sampleRate ? null : new StreamResampler(rate, sampleRate);
-    node.port.onmessage = (e: MessageEvent<Float32Array>) => {
+    const capture = { stopped: null as (() => void) | null };
+    node.port.onmessage = (e: MessageEvent<Float32Array | string>) => {
+      if (e.data === 'stopped') {
+        capture.stopped?.();
+        return;
+      }
+      if (typeof e.data === 'string') return;
       const piece = resampler ? resampler.push(e.data) : e.data;
       if (piece.length > 0) onSamples(piece);
     };
     source.connect(node);
     if (options.monitor) source.connect(context.destination);
     if (context.state === 'suspended') await context.resume().catch(() => undefined);
-    return new AudioCapture(context, node, source, stream, sampleRate, rate);
+    return new AudioCapture(context, node, source, stream, sampleRate, rate, capture);
   }
 
   /** Stop capturing. `releaseStream` also stops the stream's tracks (the browser's recording indicator goes off). */
   async stop(releaseStream = true): Promise<void> {
     if (this.stopped) return;
     this.stopped = true;
-    this.node.port.postMessage('stop');
+    if (this.context.state === 'running') {
+      // Wait for the worklet's last samples (bounded: a closed or stalled context must not hang stop()).
+      await new Promise<void>((resolve) => {
+        const timer = setTimeout(resolve, 2000);
+        this.flushed.stopped = () => {
+          clearTimeout(timer);
+          resolve();
+        };
+        this.node.port.postMessage('stop');
+      });
+    }
     this.node.port.onmessage = null;
     this.source.disconnect();
     this.node.disconnect();

@@ -30,7 +30,7 @@ async function main() {
   const live = await engine.listen(media, (_, frames) => {
     streamed.push(frames.vertices.slice());
     gaps.push(...lipGaps(frames.unposed, frames.count, n, upper, lower));
-  });
+  }, { maxLagFrames: Infinity }); // every frame, so the stream can be compared with the offline animation
   await new Promise((r) => setTimeout(r, seconds * 1000));
   const latency = live.stream.latency;
   const take = await live.stop();

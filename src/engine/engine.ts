@@ -31,6 +31,8 @@ export interface EngineOptions {
    * (SwiftShader) computes the same numbers, more slowly than the CPU path; ask for 'webgpu' to use it anyway.
    */
   backend?: 'auto' | Backend;
+  /** URL of the face template (default: the manifest's). It must be the template the model was trained on. */
+  templateUrl?: string | URL;
   /** Execution providers for the ONNX encoders, in order of preference (default: webgpu then wasm on a hardware adapter, else wasm). */
   onnxProviders?: ExecutionProvider[];
   fetch?: typeof fetch;
@@ -88,6 +90,18 @@ export interface ProducerState {
   lstmDone: number;
   poseFeatures: Float32Array;
   poseFeaturesStart: number;
+}
+
+/** Resolve on a new task (not a microtask): lets the browser handle input, rendering and timers. */
+export function yieldToEventLoop(): Promise<void> {
+  return new Promise((resolve) => {
+    const channel = new MessageChannel();
+    channel.port1.onmessage = () => {
+      channel.port1.close();
+      resolve();
+    };
+    channel.port2.postMessage(null);
+  });
 }
 
 function newProducerState(channels: number): ProducerState {
@@ -148,10 +162,12 @@ export class TalkingFaceEngine {
     const m = manifest.model.config;
     const a = manifest.audio;
     const [template, contentBytes, hierBytes, convBytes, lstmBytes, weightBytes] = await Promise.all([
-      loadTemplate(new URL(manifest.template.path, manifestUrl), fetchFn),
+      loadTemplate(options.templateUrl ? new URL(String(options.templateUrl), globalThis.location?.href ?? manifestUrl) : new URL(manifest.template.path, manifestUrl), fetchFn).catch((e: Error) => {
+        throw new ModelLoadError(`the face template could not be loaded: ${e.message}`);
+      }),
       file('content_encoder'), file('hierarchical'), file('pose_conv'), file('pose_lstm'), file('decoder_weights'),
     ]);
-    if (template.id !== manifest.template.id) throw new ModelLoadError(`the model expects template ${manifest.template.id}, got ${template.id}`);
+    if (template.id !== manifest.template.id) throw new ModelLoadError(`the model was trained on the face template "${manifest.template.id}" and cannot drive "${template.id}" (every template needs its own trained model)`);
     const support = await detectWebGPU();
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
@@ -218,6 +234,7 @@ export class TalkingFaceEngine {
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
     const state = newProducerState(this.manifest.model.config.pose_channels);
     for (let f0 = 0; f0 < F; f0 += chunk) {
+      if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
       options.signal?.throwIfAborted();
       const f1 = Math.min(F, f0 + chunk);
       const out = await this.produce(state, f0, f1, samples, 0, samples.length);
@@ -231,8 +248,8 @@ export class TalkingFaceEngine {
   }
 
   /** Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. */
-  createStream(onFrames: (first: number, frames: Frames) => void): StreamSession {
-    return new StreamSession(this, onFrames);
+  createStream(onFrames: (first: number, frames: Frames) => void, options: { maxLagFrames?: number } = {}): StreamSession {
+    return new StreamSession(this, onFrames, options.maxLagFrames);
   }
 
   /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
@@ -410,11 +427,22 @@ export class StreamSession {
   private busy: Promise<void> = Promise.resolve();
   /** Arrival of recent pushes: the stream's sample count after the push, and the time (ms) it came. */
   private arrivals: { end: number; time: number }[] = [];
+  private pending: Promise<void> | null = null;
   private latencies: number[] = [];
+
+  /** Frames skipped to catch up (see maxLagFrames). */
+  skippedFrames = 0;
 
   constructor(
     private readonly engine: TalkingFaceEngine,
     private readonly onFrames: (first: number, frames: Frames) => void,
+    /**
+     * Live use: when more than this many frames are ready but not yet computed (the device is slower
+     * than real time), skip to the newest ones instead of falling further behind; the skipped frames
+     * are never emitted (`first` jumps) and `skippedFrames` counts them. Default: never skip, so the
+     * output equals the offline animation.
+     */
+    private readonly maxLagFrames = Infinity,
   ) {
     this.state = newProducerState(engine.manifest.model.config.pose_channels);
   }
@@ -448,7 +476,15 @@ export class StreamSession {
     if (this.ended) throw new Error('StreamSession: push() after end()');
     this.append(samples);
     this.arrivals.push({ end: this.received, time: performance.now() });
-    return this.schedule(() => this.drain(false));
+    // Pushes that come while a drain runs share one follow-up drain: at most one waits, however fast
+    // the pieces come. Each drain first yields to the event loop, so a page stays responsive (promise
+    // continuations alone would starve input, rendering and timers).
+    this.pending ??= this.schedule(async () => {
+      await yieldToEventLoop();
+      this.pending = null;
+      await this.drain(false);
+    });
+    return this.pending;
   }
 
   /** No more audio: emit the remaining frames (the end of the clip is zero-padded, as offline). */
@@ -480,6 +516,11 @@ export class StreamSession {
     const last = final ? e.frameCount(this.received) : Infinity;
     let f1 = this.next;
     while (f1 < last && (final || e.samplesNeeded(f1) <= this.received)) f1++;
+    if (!final && f1 - this.next > this.maxLagFrames) {
+      const resume = f1 - Math.max(1, Math.floor(this.maxLagFrames / 4));
+      this.skippedFrames += resume - this.next;
+      this.next = resume;
+    }
     for (let f0 = this.next; f0 < f1; f0 += 96) {
       const to = Math.min(f1, f0 + 96);
       const view = this.buffer.subarray(0, this.received - this.offset);

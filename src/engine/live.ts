@@ -8,6 +8,11 @@ import type { Frames, StreamSession, TalkingFaceEngine } from './engine';
 export interface LiveOptions extends CaptureOptions {
   /** Keep the captured audio for replay (default true). A ten-minute take is 38 MB at 16 kHz. */
   keepAudio?: boolean;
+  /**
+   * Stay live on a device slower than real time: when more than this many frames wait to be computed,
+   * skip to the newest (default 15, half a second at 30 fps; Infinity keeps every frame, as offline).
+   */
+  maxLagFrames?: number;
   /** Called when processing a piece fails (the session stops). */
   onError?: (error: Error) => void;
 }
@@ -16,6 +21,7 @@ export class LiveSession {
   private pieces: Float32Array[] = [];
   private samples = 0;
   private stopping: Promise<Float32Array> | null = null;
+  private closed = false; // the capture has delivered its last piece
   private failed: Error | null = null;
 
   private constructor(
@@ -25,7 +31,7 @@ export class LiveSession {
   ) {}
 
   static async start(engine: TalkingFaceEngine, media: MediaStream, onFrames: (first: number, frames: Frames) => void, options: LiveOptions = {}): Promise<LiveSession> {
-    const stream = engine.createStream(onFrames);
+    const stream = engine.createStream(onFrames, { maxLagFrames: options.maxLagFrames ?? 15 });
     const session = new LiveSession(stream, null, options.keepAudio ?? true);
     session.capture = await AudioCapture.start(media, engine.manifest.audio.sample_rate, (piece) => session.receive(piece, options.onError), options);
     return session;
@@ -42,7 +48,7 @@ export class LiveSession {
   }
 
   private receive(piece: Float32Array, onError?: (error: Error) => void): void {
-    if (this.stopping || this.failed) return;
+    if (this.closed || this.failed) return;
     this.samples += piece.length;
     if (this.keepAudio) this.pieces.push(piece);
     this.stream.push(piece).catch((e: Error) => {
@@ -56,7 +62,8 @@ export class LiveSession {
   /** Stop capturing, emit the remaining frames, and return the take (empty when keepAudio is false). */
   stop(): Promise<Float32Array> {
     this.stopping ??= (async () => {
-      await this.capture?.stop();
+      await this.capture?.stop(); // the worklet's last pieces arrive before this resolves
+      this.closed = true;
       if (!this.failed) await this.stream.end();
       const take = new Float32Array(this.keepAudio ? this.samples : 0);
       let o = 0;

@@ -27,8 +27,13 @@ export function loadOrt(): Promise<typeof Ort> {
     ort.env.wasm.numThreads = isolated ? Math.max(1, Math.min(4, cores)) : 1;
     // onnxruntime reports node placement notes as warnings through console.error; keep real errors only.
     ort.env.logLevel = 'error';
-    // The runtime files are served next to the app (vite.config.ts copies them to ort/).
-    ort.env.wasm.wasmPaths = new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href;
+    // The runtime files are served next to the app (vite.config.ts copies them to ort/): in a build,
+    // ort/ is the sibling of the folder holding this code (assets/ for the app, lib/ for the library),
+    // so an embedding page finds them wherever it hosts the build; in dev, at the server root.
+    const sibling = '../ort/'; // (a variable, so Vite does not try to bundle it as an asset)
+    ort.env.wasm.wasmPaths = import.meta.env.DEV
+      ? new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href
+      : new URL(sibling, import.meta.url).href;
     return ort;
   });
   return ortModule;

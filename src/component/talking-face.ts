@@ -1,0 +1,379 @@
+/**
+ * <talking-face>: the whole thing as one custom element (shadow DOM). docs/embedding.md.
+ *
+ *   <script type="module" src="/lib/talking-face.js"></script>
+ *   <talking-face src="/hello.wav" autoplay></talking-face>
+ *
+ * Attributes: model (manifest URL), template (template URL; must be the model's template), src (audio
+ * URL to speak), backend (auto | cpu | webgpu), autoplay (speak src as soon as it is animated), live
+ * (animate the microphone). Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame,
+ * ended, error (detail.message is written for a person). Instances are independent; instances with the
+ * same model and backend share one engine (its runs are serialised).
+ */
+import { FaceView } from '../render/face-view';
+import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
+import type { LiveSession } from '../engine/live';
+import { decodeAudio, levels } from '../audio/decode';
+import { openMicrophone } from '../audio/capture';
+
+export const DEFAULT_MODEL = '/models/manifest.json';
+
+export interface ReadyDetail {
+  backend: Backend;
+  reason: string;
+  vertices: number;
+  model: string;
+}
+
+export interface FrameDetail {
+  /** Frame index in the current take (offline) or since the microphone started (live). */
+  frame: number;
+  /** Seconds into the audio. */
+  time: number;
+  mode: 'playback' | 'live';
+  backend: Backend;
+  /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
+  inferenceMs?: number;
+  latencyMs?: number;
+  /** Offline: seconds of audio per second of compute. */
+  realTimeFactor?: number;
+}
+
+export interface TalkingFaceErrorDetail {
+  message: string;
+  /** What failed: loading the model, decoding audio, the microphone, or inference. */
+  stage: 'model' | 'audio' | 'microphone' | 'inference';
+}
+
+const engines = new Map<string, Promise<TalkingFaceEngine>>();
+
+function sharedEngine(model: string, template: string | null, backend: string): Promise<TalkingFaceEngine> {
+  const key = `${model}|${template ?? ''}|${backend}`;
+  let p = engines.get(key);
+  if (!p) {
+    p = TalkingFaceEngine.load({ manifestUrl: model, templateUrl: template ?? undefined, backend: backend as 'auto' | Backend });
+    engines.set(key, p);
+    p.catch(() => engines.delete(key)); // a failed load can be retried
+  }
+  return p;
+}
+
+const STYLE = `
+:host { display: block; position: relative; width: 100%; aspect-ratio: 4 / 3; min-height: 160px; background: #15181d; border-radius: 8px; overflow: hidden; contain: content; }
+canvas { display: block; width: 100%; height: 100%; outline: none; }
+canvas:focus-visible { box-shadow: inset 0 0 0 3px #7ab8ff; }
+.status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45); }
+.status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
+:host([hide-status]) .status:not(.error) { display: none; }
+`;
+
+interface Playback {
+  context: AudioContext;
+  source: AudioBufferSourceNode;
+  startedAt: number;
+  done: () => void;
+}
+
+export class TalkingFaceElement extends HTMLElement {
+  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live'];
+
+  private readonly canvas: HTMLCanvasElement;
+  private readonly statusLine: HTMLParagraphElement;
+  private view: FaceView | null = null;
+  private engine: TalkingFaceEngine | null = null;
+  private loading: Promise<TalkingFaceEngine> | null = null;
+  private audioContext: AudioContext | null = null;
+  private playback: Playback | null = null;
+  private live: LiveSession | null = null;
+  private animation: Animation | null = null;
+  private computeMs = 0;
+  private audioSeconds = 0;
+  private generation = 0; // bumps on stop() and on every new speak(): stale work drops its results
+
+  constructor() {
+    super();
+    const root = this.attachShadow({ mode: 'open' });
+    const style = document.createElement('style');
+    style.textContent = STYLE;
+    this.canvas = document.createElement('canvas');
+    this.canvas.setAttribute('part', 'canvas');
+    this.canvas.tabIndex = 0;
+    this.canvas.setAttribute('role', 'img');
+    this.canvas.setAttribute('aria-label', 'Animated 3D face. Drag to orbit, scroll to zoom.');
+    this.statusLine = document.createElement('p');
+    this.statusLine.className = 'status';
+    this.statusLine.setAttribute('part', 'status');
+    this.statusLine.setAttribute('role', 'status');
+    this.statusLine.setAttribute('aria-live', 'polite');
+    root.append(style, this.canvas, this.statusLine);
+  }
+
+  /** Resolves with the engine once the model is loaded (rejects if it cannot be). */
+  get ready(): Promise<TalkingFaceEngine> {
+    return this.load();
+  }
+
+  get backend(): Backend | null {
+    return this.engine?.backend ?? null;
+  }
+
+  /** The last offline animation (posed vertices per frame), e.g. to export it. */
+  get currentAnimation(): Animation | null {
+    return this.animation;
+  }
+
+  connectedCallback(): void {
+    void this.load().then(
+      () => this.afterLoad(),
+      () => undefined, // reported by load()
+    );
+  }
+
+  disconnectedCallback(): void {
+    this.stop();
+    this.view?.dispose();
+    this.view = null;
+    void this.audioContext?.close();
+    this.audioContext = null;
+  }
+
+  attributeChangedCallback(name: string, old: string | null, value: string | null): void {
+    if (old === value || !this.isConnected) return;
+    if (name === 'model' || name === 'template') {
+      this.stop();
+      this.loading = null;
+      this.engine = null;
+      this.view?.dispose();
+      this.view = null;
+      void this.load().then(() => this.afterLoad(), () => undefined);
+    } else if (name === 'backend' && this.engine && value) {
+      this.engine.setBackend(value === 'auto' ? (this.engine.backend) : (value as Backend)).then(
+        () => this.setStatus(`Decoder: ${this.engine!.backend}.`),
+        (e: Error) => this.fail('model', `cannot switch to ${value}: ${e.message}`),
+      );
+    } else if (name === 'src' && value && this.engine) {
+      void this.speak(value).catch(() => undefined);
+    } else if (name === 'live' && this.engine) {
+      if (value !== null) void this.startMicrophone().catch(() => undefined);
+      else this.stop();
+    }
+  }
+
+  /**
+   * Animate and play `audio` (a Blob or File, an AudioBuffer, or a URL on this page's origin). Resolves
+   * when playback ends (or stop() is called); rejects with a readable Error, also sent as an error event.
+   */
+  async speak(audio: Blob | AudioBuffer | URL | string): Promise<void> {
+    const engine = await this.load();
+    this.stop();
+    const gen = ++this.generation;
+    let decoded;
+    try {
+      this.setStatus('Decoding audio…');
+      let input: Blob | AudioBuffer;
+      if (typeof audio === 'string' || audio instanceof URL) {
+        const url = new URL(String(audio), document.baseURI);
+        const res = await fetch(url).catch((e: Error) => {
+          throw new Error(`could not fetch ${url.pathname}: ${e.message}`);
+        });
+        if (!res.ok) throw new Error(`could not fetch ${url.pathname}: HTTP ${res.status}`);
+        input = await res.blob();
+      } else input = audio;
+      decoded = await decodeAudio(input, engine.manifest.audio.sample_rate);
+    } catch (e) {
+      throw this.fail('audio', `the audio could not be read: ${(e as Error).message}`);
+    }
+    if (gen !== this.generation) return;
+    const lv = levels(decoded.samples);
+    const t0 = performance.now();
+    let animation: Animation;
+    try {
+      animation = await engine.animate(decoded.samples, {
+        unposed: true,
+        onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
+      });
+    } catch (e) {
+      throw this.fail('inference', `animation failed: ${(e as Error).message}`);
+    }
+    if (gen !== this.generation) return;
+    this.computeMs = performance.now() - t0;
+    this.audioSeconds = decoded.samples.length / engine.manifest.audio.sample_rate;
+    this.animation = animation;
+    this.showFrame(0);
+    const notes = [];
+    if (lv.peak < 1e-3) notes.push('the audio is silent');
+    if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of it is clipped`);
+    this.setStatus(`${animation.frames} frames, ${(this.audioSeconds / (this.computeMs / 1000)).toFixed(1)}x real time on ${engine.backend}` +
+      (notes.length ? ` (${notes.join('; ')})` : ''));
+    await this.play(decoded.buffer, gen);
+  }
+
+  /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
+  async startMicrophone(): Promise<void> {
+    const engine = await this.load();
+    this.stop();
+    const gen = ++this.generation;
+    let media: MediaStream;
+    try {
+      media = await openMicrophone();
+    } catch (e) {
+      throw this.fail('microphone', (e as Error).message);
+    }
+    if (gen !== this.generation) {
+      for (const t of media.getTracks()) t.stop();
+      return;
+    }
+    const n = engine.template.vertexCount;
+    try {
+      this.live = await engine.listen(media, (first: number, frames: Frames) => {
+        if (gen !== this.generation || !this.view) return;
+        const last = frames.count - 1;
+        this.view.setVertices(frames.unposed.subarray(last * n * 3, (last + 1) * n * 3));
+        const p = frames.pose.subarray(last * 6, last * 6 + 6);
+        const s = engine.unitsPerMm;
+        this.view.setPose(p[0], p[1], p[2], p[3] * s, p[4] * s, p[5] * s);
+        const latency = this.live?.stream.latency;
+        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
+          detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs },
+        }));
+      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`) });
+    } catch (e) {
+      for (const t of media.getTracks()) t.stop();
+      throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
+    }
+    this.setStatus(`Listening (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms, ${engine.backend})…`);
+  }
+
+  /** Stop playback and the microphone. */
+  stop(): void {
+    this.generation++;
+    if (this.playback) {
+      const p = this.playback;
+      this.playback = null;
+      p.source.onended = null;
+      try {
+        p.source.stop();
+      } catch {
+        /* not started */
+      }
+      p.done();
+    }
+    if (this.live) {
+      const live = this.live;
+      this.live = null;
+      void live.stop().then(() => this.setStatus('Stopped listening.'));
+    }
+  }
+
+  private load(): Promise<TalkingFaceEngine> {
+    if (!this.loading) {
+      const model = this.getAttribute('model') || DEFAULT_MODEL;
+      this.setStatus('Loading the model…');
+      this.loading = sharedEngine(model, this.getAttribute('template'), this.getAttribute('backend') || 'auto').then(
+        (engine) => {
+          this.engine = engine;
+          return engine;
+        },
+        (e: Error) => {
+          this.loading = null; // a later call retries
+          throw this.fail('model', `the model could not be loaded: ${e.message}`);
+        },
+      );
+    }
+    return this.loading;
+  }
+
+  private afterLoad(): void {
+    const engine = this.engine!;
+    if (!this.view) {
+      try {
+        this.view = new FaceView(this.canvas, engine.template);
+      } catch (e) {
+        this.fail('model', `the face cannot be drawn here (WebGL unavailable?): ${(e as Error).message}`);
+        return;
+      }
+    }
+    this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
+    this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
+      detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name },
+    }));
+    const src = this.getAttribute('src');
+    if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined);
+    else if (src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined);
+  }
+
+  private play(buffer: AudioBuffer, gen: number): Promise<void> {
+    const engine = this.engine!;
+    this.audioContext ??= new AudioContext();
+    const context = this.audioContext;
+    void context.resume();
+    return new Promise<void>((resolve) => {
+      const source = context.createBufferSource();
+      source.buffer = buffer;
+      source.connect(context.destination);
+      const startedAt = context.currentTime + 0.05;
+      const done = () => {
+        resolve();
+        this.dispatchEvent(new CustomEvent('ended'));
+      };
+      this.playback = { context, source, startedAt, done };
+      source.onended = () => {
+        if (this.playback?.source === source) {
+          this.playback = null;
+          done();
+        }
+      };
+      source.start(startedAt);
+      let last = -1;
+      const tick = () => {
+        if (gen !== this.generation || !this.animation || this.playback?.source !== source) return;
+        const frame = Math.floor((context.currentTime - startedAt) * this.animation.fps);
+        if (frame !== last && frame >= 0 && frame < this.animation.frames) {
+          last = frame;
+          this.showFrame(frame);
+          this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
+            detail: {
+              frame, time: frame / this.animation.fps, mode: 'playback', backend: engine.backend,
+              inferenceMs: this.computeMs / this.animation.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
+            },
+          }));
+        }
+        requestAnimationFrame(tick);
+      };
+      requestAnimationFrame(tick);
+    });
+  }
+
+  private showFrame(frame: number): void {
+    const a = this.animation;
+    if (!a?.unposed || !this.view || !this.engine) return;
+    const n = this.engine.template.vertexCount;
+    const f = Math.min(Math.max(0, frame), a.frames - 1);
+    this.view.setVertices(a.unposed.subarray(f * n * 3, (f + 1) * n * 3));
+    const p = a.pose;
+    const s = this.engine.unitsPerMm;
+    this.view.setPose(p[f * 6], p[f * 6 + 1], p[f * 6 + 2], p[f * 6 + 3] * s, p[f * 6 + 4] * s, p[f * 6 + 5] * s);
+  }
+
+  private setStatus(text: string, isError = false): void {
+    this.statusLine.textContent = text;
+    this.statusLine.classList.toggle('error', isError);
+  }
+
+  /** Show and dispatch an error; returns it so callers can throw it. */
+  private fail(stage: TalkingFaceErrorDetail['stage'], message: string): Error {
+    this.setStatus(message, true);
+    this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
+    return new Error(message);
+  }
+}
+
+export function defineTalkingFace(name = 'talking-face'): void {
+  if (!customElements.get(name)) customElements.define(name, name === 'talking-face' ? TalkingFaceElement : class extends TalkingFaceElement {});
+}
+
+declare global {
+  interface HTMLElementTagNameMap {
+    'talking-face': TalkingFaceElement;
+  }
+}

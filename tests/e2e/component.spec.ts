@@ -1,0 +1,75 @@
+import { resolve } from 'node:path';
+import { test, expect, imageStats } from './fixtures';
+import { CHROMIUM_ARGS } from '../../playwright.config';
+
+/**
+ * <talking-face> from the library build in a plain HTML page (examples/embed.html): two instances at
+ * once, one speaking a file while the other animates the (fake) microphone; events; a bad model URL.
+ */
+const WAV = resolve(import.meta.dirname, '../fixtures/speech-kal.wav');
+test.use({
+  launchOptions: {
+    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
+    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${WAV}`],
+  },
+});
+
+type FaceEl = HTMLElement & { speak(a: string): Promise<void>; startMicrophone(): Promise<void>; stop(): void; currentAnimation: { frames: number } | null; backend: string | null };
+
+test('two instances in a plain page: one speaks a file, the other follows the microphone', async ({ page }) => {
+  test.setTimeout(180_000);
+  // Record every event before the elements upgrade.
+  await page.addInitScript(() => {
+    const seen: Record<string, string[]> = {};
+    (globalThis as unknown as { faceEvents: typeof seen }).faceEvents = seen;
+    for (const type of ['ready', 'frame', 'ended', 'error']) {
+      document.addEventListener(type, (e) => {
+        const id = (e.target as HTMLElement).id;
+        if (!id) return;
+        (seen[id] ??= []).push(type === 'frame' ? `frame:${(e as CustomEvent).detail.mode}` : type);
+      }, true);
+    }
+  });
+  await page.goto('/examples/embed.html');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).left?.includes('ready') && (await events()).right?.includes('ready'), { timeout: 60_000 }).toBe(true);
+  expect(await page.locator('#left').evaluate((el) => (el as FaceEl).backend)).toBe('cpu');
+
+  // Both faces are drawn (the canvas lives in each element's shadow root).
+  for (const id of ['#left', '#right']) {
+    const stats = await imageStats(page, await page.locator(id).screenshot());
+    expect(stats.foregroundFraction, `${id} not blank`).toBeGreaterThan(0.1);
+  }
+
+  await page.locator('#speak').click();
+  await page.locator('#mic').click();
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(10);
+  await expect.poll(async () => (await events()).right?.filter((e) => e === 'frame:live').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(10);
+  const left = await page.locator('#left').evaluate((el) => (el as FaceEl).currentAnimation?.frames ?? 0);
+  expect(left).toBe(Math.round(((103410 - 44) / 2 / 16000) * 30));
+  // Independent: the live instance has no offline animation, and the speaking one got no live frames.
+  expect(await page.locator('#right').evaluate((el) => (el as FaceEl).currentAnimation)).toBeNull();
+  expect((await events()).left).not.toContain('frame:live');
+  await expect.poll(async () => (await events()).left?.includes('ended'), { timeout: 30_000 }).toBe(true);
+  await page.locator('#stop').click();
+  expect((await events()).left).not.toContain('error');
+  expect((await events()).right).not.toContain('error');
+});
+
+test('a missing model gives an error event and message, and the page keeps working', async ({ page, guard }) => {
+  test.setTimeout(120_000);
+  guard.allowConsoleError(/404|Failed to load resource/);
+  await page.goto('/examples/embed.html');
+  const message = await page.evaluate(() => new Promise<string>((resolve) => {
+    const el = document.createElement('talking-face');
+    el.setAttribute('model', '/models/no-such-manifest.json');
+    el.addEventListener('error', (e) => resolve((e as unknown as CustomEvent).detail.message));
+    document.body.append(el);
+  }));
+  expect(message).toMatch(/model could not be loaded.*no-such-manifest\.json.*404/);
+  // The status line inside the element says so too.
+  await expect(page.locator('talking-face').last().locator('p.status')).toContainText('could not be loaded');
+  // The other instances are unaffected.
+  await page.locator('#speak').click();
+  await expect.poll(() => page.locator('#left').evaluate((el) => (el as FaceEl).currentAnimation?.frames ?? 0), { timeout: 60_000 }).toBeGreaterThan(0);
+});

@@ -1,0 +1,34 @@
+import { defineConfig, defaultClientConditions } from 'vite';
+import { cpSync } from 'node:fs';
+import { resolve } from 'node:path';
+
+/**
+ * The library build: dist/lib/talking-face.js (ES module) defines <talking-face> and exports the API
+ * (src/component/index.ts). It runs after the app build (npm run build), whose dist/models/ and
+ * dist/ort/ it uses: deploy lib/, models/ and ort/ side by side (docs/embedding.md). The example page
+ * examples/embed.html is copied to dist/examples/.
+ */
+export default defineConfig({
+  publicDir: false,
+  build: {
+    outDir: 'dist/lib',
+    emptyOutDir: true,
+    target: 'es2022',
+    sourcemap: true,
+    chunkSizeWarningLimit: 1024,
+    lib: {
+      entry: resolve(import.meta.dirname, 'src/component/index.ts'),
+      formats: ['es'],
+      fileName: () => 'talking-face.js',
+    },
+  },
+  plugins: [
+    {
+      name: 'talking-face-examples',
+      closeBundle() {
+        cpSync(resolve(import.meta.dirname, 'examples'), resolve(import.meta.dirname, 'dist/examples'), { recursive: true });
+      },
+    },
+  ],
+  resolve: { conditions: ['onnxruntime-web-use-extern-wasm', ...defaultClientConditions] },
+});
