@@ -11,6 +11,7 @@ import { FastDecoder } from '../attention/fast-decoder';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
 import { TalkingFaceEngine } from '../engine/engine';
+import { OnnxModel, type ExecutionProvider } from '../model/onnx-sessions';
 
 const maxAbsDiff = (a: ArrayLike<number>, b: ArrayLike<number>) => {
   let m = 0;
@@ -47,6 +48,35 @@ async function main() {
   result.fastVsCpuOffsets = maxAbsDiff(fast.offsets, cpu.offsets);
   result.fastVsCpuPose = maxAbsDiff(fast.pose, cpu.pose);
   result.cpuVsTorchOffsets = maxAbsDiff(cpu.offsets, f32(fx, 'offsets'));
+
+  // The ONNX encoders on onnxruntime-web, on each execution provider, against PyTorch.
+  const providers: ExecutionProvider[] = gpu.adapter ? ['wasm', 'webgpu'] : ['wasm'];
+  const encoders: Record<string, Record<string, number>> = {};
+  const mel = f32(fx, 'mel');
+  const K = mel.length / manifest.audio.n_mels;
+  const win = f32(fx, 'windows');
+  const F = win.length / (m.window * m.content_classes);
+  for (const provider of providers) {
+    const session = async (key: string, inputs: Record<string, (number | string)[]>) =>
+      OnnxModel.create({ name: key, bytes: await bin(manifest.files[key]), inputs }, [provider]);
+    const content = await session('content_encoder', { mel: [1, 'K', manifest.audio.n_mels] });
+    const hier = await session('hierarchical', { windows: ['F', m.window, m.content_classes] });
+    const conv = await session('pose_conv', { mel: [1, 'K', manifest.audio.n_mels] });
+    const lstm = await session('pose_lstm', { conv: [1, 'K', m.pose_channels], h0: [1, 1, m.pose_channels], c0: [1, 1, m.pose_channels] });
+    const row: Record<string, number> = {};
+    row.content = maxAbsDiff((await content.run({ mel: { data: mel, shape: [1, K, manifest.audio.n_mels] } })).logits.data, f32(fx, 'content_logits'));
+    const tokens = (await hier.run({ windows: { data: win, shape: [F, m.window, m.content_classes] } })).tokens.data;
+    row.hierarchical = maxAbsDiff(tokens.subarray(0, f32(fx, 'tokens').length), f32(fx, 'tokens'));
+    const convOut = (await conv.run({ mel: { data: mel, shape: [1, K, manifest.audio.n_mels] } })).conv;
+    row.pose_conv = maxAbsDiff(convOut.data, f32(fx, 'pose_conv'));
+    const zero = new Float32Array(m.pose_channels);
+    const pf = (await lstm.run({ conv: { data: convOut.data, shape: [1, K, m.pose_channels] }, h0: { data: zero, shape: [1, 1, m.pose_channels] }, c0: { data: zero, shape: [1, 1, m.pose_channels] } })).pose_features.data;
+    row.pose_lstm = maxAbsDiff(pf, f32(fx, 'pose_features'));
+    row.provider_used = content.provider === provider ? 1 : 0;
+    encoders[provider] = row;
+    for (const s of [content, hier, conv, lstm]) await s.release();
+  }
+  result.encoders = encoders;
   result.cpuVsTorchPose = maxAbsDiff(cpu.pose, f32(fx, 'pose'));
 
   // The whole engine (meyda Mel, ONNX encoders on onnxruntime-web, decoder, posing) on the fixture clip,

@@ -63,7 +63,7 @@ export class OnnxModel {
     const errors: string[] = [];
     for (const provider of providers) {
       try {
-        const session = await ort.InferenceSession.create(new Uint8Array(spec.bytes), { executionProviders: [provider], graphOptimizationLevel: 'all' });
+        const session = await ort.InferenceSession.create(new Uint8Array(spec.bytes), { executionProviders: [provider], graphOptimizationLevel: 'all', logSeverityLevel: 3 });
         const missing = Object.keys(spec.inputs).filter((n) => !session.inputNames.includes(n));
         if (missing.length) throw new ModelLoadError(`${spec.name}: the model file has no input ${missing.join(', ')} (inputs: ${session.inputNames.join(', ')}); models/ does not match this build`);
         return new OnnxModel(spec.name, session, provider, ort, spec.inputs);

@@ -18,6 +18,13 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the 
   expect(r.cpuVsTorchOffsets as number).toBeLessThan(1e-4);
   expect(r.cpuVsTorchPose as number).toBeLessThan(1e-5);
   expect(r.gpuRepeatable).toBe(true);
+  // The ONNX encoders on onnxruntime-web, wasm and webgpu execution providers, against PyTorch.
+  const encoders = r.encoders as unknown as Record<string, Record<string, number>>;
+  expect(Object.keys(encoders).sort()).toEqual(['wasm', 'webgpu']);
+  for (const [provider, row] of Object.entries(encoders)) {
+    expect(row.provider_used, provider).toBe(1);
+    for (const stage of ['content', 'hierarchical', 'pose_conv', 'pose_lstm']) expect(row[stage], `${provider} ${stage}`).toBeLessThan(1e-4);
+  }
   // The whole engine against PyTorch's final vertices (template units: cm), chunked = whole, WebGPU = CPU.
   expect(r.engineFrames).toBe(18);
   expect(r.engineCpuVsTorch as number).toBeLessThan(1e-4);
