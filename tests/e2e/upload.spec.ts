@@ -41,14 +41,14 @@ test.describe('animating an audio file', () => {
   test('speech opens and closes the mouth, and the take can be played', async ({ page }) => {
     await page.locator('#file-input').setInputFiles(SPEECH);
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
-    await expect(page.locator('#status')).toContainText('Animated');
+    await expect(page.locator('#status')).toContainText('x real time');
     const gaps = await lipGaps(page);
     const seconds = (readFileSync(SPEECH).length - 44) / 2 / 16000;
     expect(gaps.length).toBe(Math.round(seconds * 30));
     expect(Math.max(...gaps) - Math.min(...gaps)).toBeGreaterThan(2); // it moves by millimetres, not noise
     await expect(page.locator('#play-button')).toBeEnabled();
     await page.locator('#play-button').click();
-    await expect(page.locator('#play-button')).toHaveText('Stop');
+    await expect(page.locator('#play-button')).toHaveText('Pause');
   });
 
   test('a silent recording is animated and reported as silent', async ({ page }) => {

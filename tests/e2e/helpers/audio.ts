@@ -1,0 +1,57 @@
+/** WAV files made in the test process from tests/fixtures/speech-kal.wav (16 kHz mono PCM16). */
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import type { Page } from '@playwright/test';
+
+export const SPEECH = resolve(import.meta.dirname, '../../fixtures/speech-kal.wav');
+
+export function speechSamples(): { samples: Float32Array; rate: number } {
+  const b = readFileSync(SPEECH);
+  const n = (b.length - 44) >> 1;
+  const samples = new Float32Array(n);
+  for (let i = 0; i < n; i++) samples[i] = b.readInt16LE(44 + 2 * i) / 32768;
+  return { samples, rate: 16000 };
+}
+
+/** 16-bit PCM WAV; `channels` are interleaved from the given per-channel arrays. */
+export function wav(channels: Float32Array[], rate: number): Buffer {
+  const n = channels[0].length;
+  const c = channels.length;
+  const b = Buffer.alloc(44 + 2 * n * c);
+  b.write('RIFF', 0); b.writeUInt32LE(36 + 2 * n * c, 4); b.write('WAVE', 8); b.write('fmt ', 12);
+  b.writeUInt32LE(16, 16); b.writeUInt16LE(1, 20); b.writeUInt16LE(c, 22); b.writeUInt32LE(rate, 24);
+  b.writeUInt32LE(2 * rate * c, 28); b.writeUInt16LE(2 * c, 32); b.writeUInt16LE(16, 34); b.write('data', 36); b.writeUInt32LE(2 * n * c, 40);
+  for (let i = 0; i < n; i++) for (let k = 0; k < c; k++) b.writeInt16LE(Math.max(-32768, Math.min(32767, Math.round(channels[k][i] * 32767))), 44 + 2 * (i * c + k));
+  return b;
+}
+
+/** Linear-interpolation resampling (good enough for speech at these rates in a test). */
+export function resample(x: Float32Array, from: number, to: number): Float32Array {
+  const n = Math.floor((x.length * to) / from);
+  const y = new Float32Array(n);
+  for (let i = 0; i < n; i++) {
+    const p = (i * from) / to;
+    const k = Math.floor(p);
+    const t = p - k;
+    y[i] = (1 - t) * x[k] + t * (x[Math.min(k + 1, x.length - 1)] ?? 0);
+  }
+  return y;
+}
+
+/** Per frame of the demo's current take: mean height of the upper inner lip above the lower one, in mm. */
+export async function lipGaps(page: Page): Promise<number[]> {
+  return page.evaluate(() => {
+    const tf = (globalThis as unknown as { talkingFace: { template: { vertexCount: number; regions: Record<string, Uint32Array> }; engine: { unitsPerMm: number }; take: { animation: { frames: number; unposed: Float32Array } } } }).talkingFace;
+    const { regions, vertexCount: n } = tf.template;
+    const up = Array.from(regions.lips_inner_upper).filter((v) => !regions.lips_inner_lower.includes(v));
+    const lo = Array.from(regions.lips_inner_lower).filter((v) => !regions.lips_inner_upper.includes(v));
+    const u = tf.take.animation.unposed;
+    const mmPerUnit = 1 / tf.engine.unitsPerMm;
+    const gaps: number[] = [];
+    for (let f = 0; f < tf.take.animation.frames; f++) {
+      const y = (idx: number[]) => idx.reduce((s, v) => s + u[(f * n + v) * 3 + 1], 0) / idx.length;
+      gaps.push(mmPerUnit * (y(up) - y(lo)));
+    }
+    return gaps;
+  });
+}
