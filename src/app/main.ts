@@ -10,6 +10,7 @@ import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '..
 import type { LiveSession } from '../engine/live';
 import { decodeAudio, levels } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
+import { exportGlb, inspectGlb, rawFrames, download } from './export-glb';
 
 const TEMPLATE_URL = '/models/template/template.json';
 const MANIFEST_URL = '/models/manifest.json';
@@ -28,6 +29,15 @@ const loopCheck = $<HTMLInputElement>('loop-check');
 const scrub = $<HTMLInputElement>('scrub');
 const timeLabel = $<HTMLOutputElement>('time-label');
 const clipInfo = $<HTMLSpanElement>('clip-info');
+const sampleSelect = $<HTMLSelectElement>('sample-select');
+const arrowsCheck = $<HTMLInputElement>('arrows-check');
+const paintSelect = $<HTMLSelectElement>('paint-select');
+const sideCheck = $<HTMLInputElement>('side-check');
+const gtView = $<HTMLElement>('gt-view');
+const gtCanvas = $<HTMLCanvasElement>('gt-canvas');
+const legend = $<HTMLParagraphElement>('legend');
+const exportGlbButton = $<HTMLButtonElement>('export-glb');
+const exportRawButton = $<HTMLButtonElement>('export-raw');
 const stage = $<HTMLElement>('stage');
 const dropHint = $<HTMLParagraphElement>('drop-hint');
 
@@ -39,11 +49,36 @@ function showStatus(text: string, isError = false): void {
 interface Take {
   animation: Animation;
   buffer: AudioBuffer;
+  /** The audio at the model's rate (for attention maps). */
+  samples: Float32Array;
   name: string;
   seconds: number;
   computeMs: number;
   backend: Backend;
+  truth?: Truth;
+  /** E_vl of the whole take against its ground truth (mm), computed once. */
+  lipError?: number;
 }
+
+/** Ground truth of a sample clip: the subject's neutral face, the unposed frames and poses (template units). */
+interface Truth {
+  template: Float32Array;
+  unposed: Float32Array;
+  pose: Float32Array;
+  frames: number;
+}
+
+interface SampleEntry {
+  name: string; text: string; voice: string; source: string; frames: number; seconds: number;
+  audio: string; ground_truth: string; vertices: number; audio_sha256: string; ground_truth_sha256: string;
+}
+
+const SAMPLES_URL = '/models/samples/index.json';
+let sampleIndex: { units: string; clips: SampleEntry[] } | null = null;
+let truthView: FaceView | null = null;
+let pickedVertex: number | null = null;
+let paintJob = 0;
+let lipMask: Uint8Array | null = null;
 
 let view: FaceView;
 let engine: TalkingFaceEngine | null = null;
@@ -57,7 +92,13 @@ let recording: { live: LiveSession; frames: Frames[]; started: number } | null =
 let baseStatus = '';
 
 function publish(): void {
-  Object.assign(globalThis, { talkingFace: { view, template: view?.template, gpu: lastGpu, engine, take } });
+  Object.assign(globalThis, {
+    talkingFace: {
+      view, template: view?.template, gpu: lastGpu, engine, take, truthView,
+      exportGlb: async () => (take && engine ? exportGlb(take.animation, view.template, engine.unitsPerMm) : null),
+      inspectGlb,
+    },
+  });
 }
 let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
 
@@ -77,6 +118,7 @@ async function start(): Promise<void> {
     publish();
     showStatus(`${baseStatus} Model ${engine.manifest.model.name} ready. Decoder: ${engine.backend} (${engine.backendReason}). Open or drop an audio file, or record.`);
     document.body.dataset.engine = 'ready';
+    void loadSampleIndex();
   } catch (e) {
     showStatus(`${baseStatus} The model could not be loaded: ${(e as Error).message}. The face can still be viewed.`, true);
     document.body.dataset.engine = 'error';
@@ -120,7 +162,7 @@ async function animateFile(file: File): Promise<void> {
       signal: controller.signal,
       onProgress: (done, total) => showStatus(`Animating ${file.name}: frame ${done} of ${total} (${Math.round((100 * done) / total)}%)…` + (notes.length ? ` Note: ${notes.join('; ')}.` : '')),
     });
-    setTake({ animation, buffer: audio.buffer, name: file.name, seconds: src.seconds, computeMs: performance.now() - computeStart, backend: e.backend }, notes);
+    setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: file.name, seconds: src.seconds, computeMs: performance.now() - computeStart, backend: e.backend }, notes);
   } catch (err) {
     if (controller.signal.aborted) {
       showStatus(`Stopped animating ${file.name}. Open another file or record.`);
@@ -141,10 +183,23 @@ function setTake(t: Take, notes: string[] = []): void {
   showStatus(`${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${perFrame.toFixed(1)} ms per frame, ` +
     `${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time.` + (notes.length ? ` Note: ${notes.join('; ')}.` : ''));
   playButton.disabled = false;
+  exportGlbButton.disabled = false;
+  exportRawButton.disabled = false;
   scrub.disabled = false;
   scrub.max = String(t.animation.frames - 1);
   showFrame(0);
   document.body.dataset.take = 'ready';
+}
+
+/** Frame f of the prediction as drawn: on the sample subject's own face when there is ground truth. */
+function predictedFrame(f: number): Float32Array {
+  const n3 = view.template.vertexCount * 3;
+  const u = take!.animation.unposed!.subarray(f * n3, (f + 1) * n3);
+  const truth = take!.truth;
+  if (!truth) return u;
+  const out = new Float32Array(n3);
+  for (let i = 0; i < n3; i++) out[i] = truth.template[i] + u[i] - view.template.positions[i];
+  return out;
 }
 
 function showFrame(frame: number): void {
@@ -152,12 +207,200 @@ function showFrame(frame: number): void {
   const n = view.template.vertexCount;
   const f = Math.min(Math.max(0, frame), take.animation.frames - 1);
   current = f;
-  view.setVertices(take.animation.unposed.subarray(f * n * 3, (f + 1) * n * 3));
+  view.setVertices(predictedFrame(f));
   const p = take.animation.pose;
   const s = engine.unitsPerMm;
   view.setPose(p[f * 6], p[f * 6 + 1], p[f * 6 + 2], p[f * 6 + 3] * s, p[f * 6 + 4] * s, p[f * 6 + 5] * s);
+  const truth = take.truth;
+  if (truth && truthView) {
+    const g = Math.min(f, truth.frames - 1);
+    truthView.setVertices(truth.unposed.subarray(g * n * 3, (g + 1) * n * 3));
+    const q = truth.pose;
+    truthView.setPose(q[g * 6], q[g * 6 + 1], q[g * 6 + 2], q[g * 6 + 3], q[g * 6 + 4], q[g * 6 + 5]);
+  }
   scrub.value = String(f);
   timeLabel.value = `${(f / take.animation.fps).toFixed(2)} s`;
+  paint();
+}
+
+/** Colour the face by the chosen quantity at the current frame (attention maps only when paused: they are recomputed). */
+function paint(): void {
+  const mode = paintSelect.value;
+  const job = ++paintJob;
+  const n = view.template.vertexCount;
+  if (mode === 'none' || !take || !engine) {
+    view.setColorMap(null);
+    legend.hidden = true;
+    return;
+  }
+  if (mode === 'error') {
+    const truth = take.truth;
+    if (!truth) {
+      view.setColorMap(null);
+      showLegend('The error map needs a sample clip (it has ground truth).');
+      return;
+    }
+    const f = Math.min(current, truth.frames - 1);
+    const pred = predictedFrame(current);
+    const mmPerUnit = 1 / engine.unitsPerMm;
+    const err = new Float32Array(n);
+    let lipMax = 0;
+    for (let v = 0; v < n; v++) {
+      const o = (f * n + v) * 3;
+      err[v] = mmPerUnit * Math.hypot(pred[3 * v] - truth.unposed[o], pred[3 * v + 1] - truth.unposed[o + 1], pred[3 * v + 2] - truth.unposed[o + 2]);
+      if (lipMask?.[v]) lipMax = Math.max(lipMax, err[v]);
+    }
+    view.setColorMap(err, 5);
+    showLegend(`Error vs ground truth: 0<span class="ramp"></span>5 mm. This frame's largest lip error ${lipMax.toFixed(2)} mm; clip E_vl ${(take.lipError ??= clipLipError()).toFixed(2)} mm.`);
+    return;
+  }
+  if (playing) {
+    showLegend('Attention maps are computed for the paused frame: pause or scrub.');
+    return;
+  }
+  const frame = current;
+  void engine.attentionAt(take.samples, frame).then((maps) => {
+    if (job !== paintJob) return;
+    const values = new Float32Array(n);
+    let max = 0;
+    if (mode === 'pose-attention') {
+      for (let v = 0; v < n; v++) max = Math.max(max, (values[v] = maps.poseToken[v]));
+      view.setColorMap(values, max);
+      showLegend(`Pose token attention, layer ${maps.layer + 1} (paper Fig. 7): 0<span class="ramp"></span>${max.toFixed(4)}; the pose token itself: ${maps.poseToken[n].toFixed(4)}.`);
+    } else {
+      const j = pickedVertex ?? view.template.regions.lips_outer_upper[Math.floor(view.template.regions.lips_outer_upper.length / 2)];
+      for (let k = maps.keyStart[j]; k < maps.keyStart[j + 1]; k++) max = Math.max(max, (values[maps.keys[k]] = maps.vertexWeights[k]));
+      view.setColorMap(values, max);
+      showLegend(`Vertex ${j}'s attention over itself and its ${maps.keyStart[j + 1] - maps.keyStart[j] - 1} neighbours, layer ${maps.layer + 1} (paper Fig. 10): ` +
+        `0<span class="ramp"></span>${max.toFixed(3)}. Click the face to choose another vertex.`);
+    }
+    document.body.dataset.painted = mode;
+  }, (err: Error) => showLegend(`Attention map failed: ${err.message}`));
+}
+
+function showLegend(html: string): void {
+  legend.innerHTML = html;
+  legend.hidden = false;
+}
+
+/** The paper's E_vl for the current sample take: mean over frames of the largest lip-vertex error (mm). */
+function clipLipError(): number {
+  const truth = take?.truth;
+  if (!truth || !lipMask || !engine) return NaN;
+  const n = view.template.vertexCount;
+  const frames = Math.min(truth.frames, take!.animation.frames);
+  let sum = 0;
+  for (let f = 0; f < frames; f++) {
+    const pred = predictedFrame(f);
+    let worst = 0;
+    for (let v = 0; v < n; v++) {
+      if (!lipMask[v]) continue;
+      const o = (f * n + v) * 3;
+      worst = Math.max(worst, Math.hypot(pred[3 * v] - truth.unposed[o], pred[3 * v + 1] - truth.unposed[o + 1], pred[3 * v + 2] - truth.unposed[o + 2]));
+    }
+    sum += worst / engine.unitsPerMm;
+  }
+  return sum / frames;
+}
+
+/** Lip vertices: flood the 1-ring graph from the inner-lip contour to the outer one (as training's metrics). */
+function lipRegion(): Uint8Array {
+  const t = view.template;
+  const mask = new Uint8Array(t.vertexCount);
+  const outer = new Set(t.regions.lips_outer);
+  const queue = [...t.regions.lips_inner_upper, ...t.regions.lips_inner_lower];
+  for (const v of queue) mask[v] = 1;
+  while (queue.length) {
+    const v = queue.pop()!;
+    if (outer.has(v)) continue;
+    for (let k = t.adjacency.offsets[v]; k < t.adjacency.offsets[v + 1]; k++) {
+      const w = t.adjacency.indices[k];
+      if (!mask[w]) {
+        mask[w] = 1;
+        queue.push(w);
+      }
+    }
+  }
+  return mask;
+}
+
+async function loadSampleIndex(): Promise<void> {
+  try {
+    const res = await fetch(SAMPLES_URL);
+    if (!res.ok) throw new Error(`HTTP ${res.status}`);
+    sampleIndex = await res.json();
+    for (const c of sampleIndex!.clips) {
+      const o = document.createElement('option');
+      o.value = c.name;
+      o.textContent = `"${c.text}" (${c.source === 'human' ? 'recorded voice' : c.voice}, ${c.seconds.toFixed(1)} s)`;
+      sampleSelect.append(o);
+    }
+  } catch (e) {
+    sampleSelect.disabled = true;
+    sampleSelect.title = `No sample clips: ${(e as Error).message}`;
+  }
+}
+
+async function sha256Hex(bytes: ArrayBuffer): Promise<string> {
+  return Array.from(new Uint8Array(await crypto.subtle.digest('SHA-256', bytes)), (b) => b.toString(16).padStart(2, '0')).join('');
+}
+
+async function openSample(name: string): Promise<void> {
+  const e = needEngine();
+  const c = sampleIndex?.clips.find((x) => x.name === name);
+  if (!e || !c || recording) return;
+  busy?.abort();
+  stopPlayback();
+  const controller = new AbortController();
+  setBusy(controller);
+  try {
+    showStatus(`Loading the sample "${c.text}"…`);
+    const [audioBytes, truthBytes] = await Promise.all([c.audio, c.ground_truth].map(async (f) => {
+      const r = await fetch(`/models/samples/${f}`);
+      if (!r.ok) throw new Error(`${f}: HTTP ${r.status}`);
+      return r.arrayBuffer();
+    }));
+    if ((await sha256Hex(audioBytes)) !== c.audio_sha256 || (await sha256Hex(truthBytes)) !== c.ground_truth_sha256) {
+      throw new Error('the sample files do not match their index (corrupt download?)');
+    }
+    const n = view.template.vertexCount;
+    if (c.vertices !== n) throw new Error(`the sample has ${c.vertices} vertices, the face ${n}`);
+    const truth = decodeTruth(truthBytes, n, c.frames, e.unitsPerMm);
+    lipMask ??= lipRegion();
+    const audio = await decodeAudio(audioBytes, e.manifest.audio.sample_rate);
+    e.resetTimes();
+    const t0 = performance.now();
+    const animation = await e.animate(audio.samples, {
+      unposed: true,
+      signal: controller.signal,
+      onProgress: (done, total) => showStatus(`Animating the sample: frame ${done} of ${total}…`),
+    });
+    clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}"`;
+    setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: c.name, seconds: c.seconds, computeMs: performance.now() - t0, backend: e.backend, truth });
+    lipMask ??= lipRegion();
+    take!.lipError = clipLipError();
+    showStatus(`${status.textContent} E_vl on this clip: ${take!.lipError.toFixed(2)} mm.`);
+  } catch (err) {
+    if (!controller.signal.aborted) showStatus(`Could not open the sample: ${(err as Error).message}`, true);
+  } finally {
+    if (busy === controller) setBusy(null);
+  }
+}
+
+/** samples.py's layout: float32 (N,3) neutral face; int16 (F,N,3) micrometre offsets; float32 (F,6) pose (units). */
+function decodeTruth(bytes: ArrayBuffer, n: number, frames: number, unitsPerMm: number): Truth {
+  const expected = n * 12 + frames * n * 6 + frames * 24;
+  if (bytes.byteLength !== expected) throw new Error(`ground truth has ${bytes.byteLength} bytes, expected ${expected}`);
+  const view = new DataView(bytes);
+  const template = new Float32Array(n * 3);
+  for (let i = 0; i < n * 3; i++) template[i] = view.getFloat32(4 * i, true);
+  const unposed = new Float32Array(frames * n * 3);
+  const base = n * 12;
+  for (let i = 0; i < frames * n * 3; i++) unposed[i] = template[i % (n * 3)] + (view.getInt16(base + 2 * i, true) / 1000) * unitsPerMm;
+  const pose = new Float32Array(frames * 6);
+  const pb = base + frames * n * 6;
+  for (let i = 0; i < frames * 6; i++) pose[i] = view.getFloat32(pb + 4 * i, true);
+  return { template, unposed, pose, frames };
 }
 
 function showLiveFrame(frames: Frames): void {
@@ -245,7 +488,7 @@ async function toggleRecording(): Promise<void> {
       const lv = levels(samples);
       const notes = lv.peak < 1e-3 ? ['the take is silent (is the microphone muted?)'] : [];
       clipInfo.textContent = `Recording: ${seconds.toFixed(1)} s`;
-      setTake({ animation, buffer, name: 'Recording', seconds, computeMs, backend: e.backend }, notes);
+      setTake({ animation, buffer, samples, name: 'Recording', seconds, computeMs, backend: e.backend }, notes);
     } catch (err) {
       showStatus(`The recording could not be finished: ${(err as Error).message}`, true);
     } finally {
@@ -299,6 +542,50 @@ function joinFrames(chunks: Frames[], fps: number): Animation {
   }
   return { fps, frames: count, vertices, pose, unposed };
 }
+
+sampleSelect.addEventListener('change', () => {
+  if (sampleSelect.value) void openSample(sampleSelect.value);
+});
+arrowsCheck.addEventListener('change', () => {
+  view.showPoseArrows(arrowsCheck.checked);
+  truthView?.showPoseArrows(arrowsCheck.checked);
+});
+paintSelect.addEventListener('change', () => paint());
+sideCheck.addEventListener('change', () => {
+  gtView.hidden = !sideCheck.checked;
+  if (sideCheck.checked && !truthView) {
+    truthView = new FaceView(gtCanvas, view.template);
+    truthView.showPoseArrows(arrowsCheck.checked);
+    publish();
+  }
+  if (sideCheck.checked && !take?.truth) showLegend('Side by side needs a sample clip (it has ground truth).');
+  showFrame(current);
+});
+canvas.addEventListener('click', (ev) => {
+  if (paintSelect.value !== 'vertex-attention') return;
+  const v = view.pickVertex(ev.clientX, ev.clientY);
+  if (v !== null) {
+    pickedVertex = v;
+    paint();
+  }
+});
+exportGlbButton.addEventListener('click', async () => {
+  if (!take || !engine) return;
+  try {
+    const glb = await exportGlb(take.animation, view.template, engine.unitsPerMm);
+    download(new Blob([glb.bytes], { type: 'model/gltf-binary' }), `${take.name.replace(/\.[^.]+$/, '')}.glb`);
+    showStatus(`Exported ${glb.frames} frames as .glb (${(glb.bytes.byteLength / 1e6).toFixed(1)} MB)` +
+      (glb.truncated ? `; the clip is longer, so only its first ${glb.frames} frames (one morph target per frame)` : '') + '.');
+  } catch (err) {
+    showStatus(`Export failed: ${(err as Error).message}`, true);
+  }
+});
+exportRawButton.addEventListener('click', () => {
+  if (!take) return;
+  const n = view.template.vertexCount;
+  download(rawFrames(take.animation), `${take.name.replace(/\.[^.]+$/, '')}.${take.animation.frames}x${n}x3.f32`);
+  showStatus(`Exported ${take.animation.frames} frames x ${n} vertices x 3 as float32 (little-endian, ${view.template.units}, ${take.animation.fps} fps).`);
+});
 
 fileInput.addEventListener('change', () => {
   const file = fileInput.files?.[0];

@@ -91,6 +91,17 @@ export interface DecodeResult {
   pose: Float32Array; // (F x 6) axis-angle (rad), translation (mm)
 }
 
+/** Attention weights of one layer for one frame (averaged over heads), for the paper's Fig. 7 and Fig. 10. */
+export interface AttentionMaps {
+  layer: number;
+  /** (N + 1): how much the pose token attends to each vertex token (and, last, to itself). */
+  poseToken: Float32Array;
+  /** Vertex j's weights over its keys: keys[keyStart[j] .. keyStart[j + 1]) = [j, its 1-ring...]. */
+  vertexWeights: Float32Array;
+  keyStart: Int32Array;
+  keys: Int32Array;
+}
+
 export class ReferenceDecoder {
   readonly n: number;
   private readonly d: number;
@@ -117,6 +128,29 @@ export class ReferenceDecoder {
     this.scores = new Float32Array(T);
   }
 
+  private capture: AttentionMaps | null = null;
+
+  /** The attention weights of `layer` (0-based) when decoding frame 0 of tokens / poseToken. */
+  attention(tokens: Float32Array, poseToken: Float32Array, layer: number): AttentionMaps {
+    const n = this.n;
+    const { offsets: ro, indices: ri } = this.adjacency;
+    const keyStart = new Int32Array(n + 1);
+    const keys = new Int32Array(n + ri.length);
+    for (let j = 0, k = 0; j < n; j++) {
+      keyStart[j] = k;
+      keys[k++] = j;
+      for (let e = ro[j]; e < ro[j + 1]; e++) keys[k++] = ri[e];
+      keyStart[j + 1] = k;
+    }
+    this.capture = { layer, poseToken: new Float32Array(n + 1), vertexWeights: new Float32Array(keys.length), keyStart, keys };
+    try {
+      this.decode(tokens, poseToken, 1);
+      return this.capture;
+    } finally {
+      this.capture = null;
+    }
+  }
+
   /** tokens (F x N x d), poseToken (F x d) -> displacement and pose per frame. `layerOut` receives each layer's tokens of frame 0. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number, layerOut?: Float32Array[]): DecodeResult {
     const { n, d } = this;
@@ -126,7 +160,7 @@ export class ReferenceDecoder {
       this.x.set(tokens.subarray(f * n * d, (f + 1) * n * d), 0);
       this.x.set(poseToken.subarray(f * d, (f + 1) * d), n * d);
       this.weights.layers.forEach((L, i) => {
-        this.layer(L);
+        this.layer(L, i);
         if (f === 0 && layerOut) layerOut[i] = this.x.slice();
       });
       this.heads(offsets, pose, f);
@@ -134,7 +168,7 @@ export class ReferenceDecoder {
     return { offsets, pose };
   }
 
-  private layer(L: LayerWeights): void {
+  private layer(L: LayerWeights, index: number): void {
     const { n, d, x, h, qkv, attn } = this;
     const T = n + 1;
     const heads = this.m.heads;
@@ -166,8 +200,13 @@ export class ReferenceDecoder {
         }
         const ao = t * d + hd * dk;
         for (let i = 0; i < dk; i++) attn[ao + i] = 0;
+        const cap = this.capture && this.capture.layer === index ? this.capture : null;
         for (let s = 0; s < count; s++) {
           const w = this.scores[s] / sum;
+          if (cap) {
+            if (t === n) cap.poseToken[s] += w / heads;
+            else cap.vertexWeights[cap.keyStart[t] + s] += w / heads;
+          }
           const vo = key(s) * 3 * d + 2 * d + hd * dk;
           for (let i = 0; i < dk; i++) attn[ao + i] += w * qkv[vo + i];
         }

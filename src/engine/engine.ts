@@ -14,7 +14,7 @@ import { parseSafetensors } from '../model/safetensors';
 import { OnnxModel, type ExecutionProvider, ModelLoadError } from '../model/onnx-sessions';
 import { contentWindows, softmaxRows } from '../model/windows';
 import { logMelFrames, melFrameCount } from '../audio/mel';
-import { applyPose, decoderWeights, type DecodeResult, type DecoderWeights } from '../attention/reference';
+import { ReferenceDecoder, applyPose, decoderWeights, type AttentionMaps, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { FastDecoder } from '../attention/fast-decoder';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { LiveSession, type LiveOptions } from './live';
@@ -112,6 +112,7 @@ export class TalkingFaceEngine {
   readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
   private gpu: GpuDecoder | null;
   private readonly cpu: FastDecoder;
+  private reference: ReferenceDecoder | null = null;
   private readonly templateMm: Float32Array;
   private readonly mmPerUnit: number;
   backend: Backend;
@@ -247,6 +248,20 @@ export class TalkingFaceEngine {
     return { fps: this.fps, frames: F, vertices, pose, unposed };
   }
 
+  /**
+   * The decoder's attention at one frame of a clip (layer 0-based; default the last, as the paper's
+   * Fig. 7 reads the third): the pose token's weights over the vertices, and each vertex's over its
+   * 1-ring. Computed by the reference decoder from exactly the tokens the animation used.
+   */
+  async attentionAt(samples: Float32Array, frame: number, layer = this.manifest.model.config.layers - 1): Promise<AttentionMaps> {
+    const F = this.frameCount(samples.length);
+    const f = Math.min(Math.max(0, Math.floor(frame)), F - 1);
+    const inputs: { tokens?: Float32Array; poseToken?: Float32Array } = {};
+    await this.produce(newProducerState(this.manifest.model.config.pose_channels), f, f + 1, samples, 0, samples.length, inputs);
+    this.reference ??= new ReferenceDecoder(this.cpu.weights, this.template.adjacency, this.manifest.model.config);
+    return this.reference.attention(inputs.tokens!, inputs.poseToken!, layer);
+  }
+
   /** Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. */
   createStream(onFrames: (first: number, frames: Frames) => void, options: { maxLagFrames?: number } = {}): StreamSession {
     return new StreamSession(this, onFrames, options.maxLagFrames);
@@ -273,7 +288,8 @@ export class TalkingFaceEngine {
    * [offset, offset + samples.length). Exact whenever the samples cover every frame's receptive field.
    * @internal
    */
-  async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number): Promise<Frames> {
+  async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number,
+    inputs?: { tokens?: Float32Array; poseToken?: Float32Array }): Promise<Frames> {
     const a = this.manifest.audio;
     const m = this.manifest.model.config;
     const C = m.pose_channels;
@@ -337,6 +353,10 @@ export class TalkingFaceEngine {
     melIndex.forEach((k, i) => poseToken.set(pf.subarray((k - state.poseFeaturesStart) * m.d_model, (k - state.poseFeaturesStart + 1) * m.d_model), i * m.d_model));
     this.times.pose += performance.now() - t;
 
+    if (inputs) {
+      inputs.tokens = tokens;
+      inputs.poseToken = poseToken;
+    }
     t = performance.now();
     const decoded = await this.decode(tokens, poseToken, melIndex.length);
     this.times.decoder += performance.now() - t;

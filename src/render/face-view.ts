@@ -29,6 +29,8 @@ export class FaceView {
   private readonly resizeObserver: ResizeObserver;
   private needsRender = true;
   private frameHandle = 0;
+  private readonly skin: Float32Array;
+  private arrows: { template: THREE.ArrowHelper; current: THREE.ArrowHelper } | null = null;
 
   constructor(
     private readonly canvas: HTMLCanvasElement,
@@ -44,7 +46,8 @@ export class FaceView {
     geometry.setAttribute('position', this.positions);
     if (template.uvs) geometry.setAttribute('uv', new THREE.BufferAttribute(template.uvs, 2));
     geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
-    geometry.setAttribute('color', new THREE.BufferAttribute(skinColors(template), 3));
+    this.skin = skinColors(template);
+    geometry.setAttribute('color', new THREE.BufferAttribute(this.skin.slice(), 3));
     geometry.computeVertexNormals();
     geometry.computeBoundingSphere();
     this.face = new THREE.Mesh(
@@ -102,6 +105,67 @@ export class FaceView {
 
   requestRender(): void {
     this.needsRender = true;
+  }
+
+  /**
+   * Paint a per-vertex scalar on the face (0 -> dark blue, `max` -> red, through cyan, green and yellow),
+   * e.g. an error in mm or an attention weight; null restores the skin colours.
+   */
+  setColorMap(values: ArrayLike<number> | null, max = 1): void {
+    const color = this.face.geometry.getAttribute('color') as THREE.BufferAttribute;
+    const c = color.array as Float32Array;
+    if (!values) c.set(this.skin);
+    else {
+      if (values.length !== this.template.vertexCount) throw new Error(`setColorMap: expected ${this.template.vertexCount} values, got ${values.length}`);
+      for (let v = 0; v < values.length; v++) heat(Math.min(1, Math.max(0, values[v] / (max || 1))), c, 3 * v);
+    }
+    color.needsUpdate = true;
+    this.requestRender();
+  }
+
+  /** The vertex nearest the point under (clientX, clientY) on the face, or null if the face is not there. */
+  pickVertex(clientX: number, clientY: number): number | null {
+    const r = this.canvas.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
+    const ray = new THREE.Raycaster();
+    ray.setFromCamera(ndc, this.camera);
+    this.face.geometry.computeBoundingSphere();
+    const hit = ray.intersectObject(this.face, false)[0];
+    if (!hit?.face) return null;
+    const local = this.face.worldToLocal(hit.point.clone());
+    let best = hit.face.a, bestD = Infinity;
+    for (const v of [hit.face.a, hit.face.b, hit.face.c]) {
+      const d = local.distanceToSquared(new THREE.Vector3().fromBufferAttribute(this.positions, v));
+      if (d < bestD) [best, bestD] = [v, d];
+    }
+    return best;
+  }
+
+  /**
+   * The paper's Fig. 1 pose arrows: the nose-tip normal of the template (grey, fixed) and of the current
+   * frame (orange, moves with the head pose).
+   */
+  showPoseArrows(on: boolean): void {
+    if (on && !this.arrows) {
+      const tip = this.template.regions.nose_tip?.[0];
+      if (tip === undefined) return;
+      const geometry = this.face.geometry;
+      const origin = new THREE.Vector3().fromBufferAttribute(this.positions, tip);
+      const normal = new THREE.Vector3().fromBufferAttribute(geometry.getAttribute('normal') as THREE.BufferAttribute, tip).normalize();
+      const length = geometry.boundingSphere!.radius * 0.9;
+      const template = new THREE.ArrowHelper(normal, origin, length, 0xb0b6c4, length * 0.15, length * 0.07);
+      const current = new THREE.ArrowHelper(normal, origin, length, 0xff8a3d, length * 0.15, length * 0.07);
+      template.name = 'pose_arrow_template';
+      current.name = 'pose_arrow_current';
+      this.scene.add(template);
+      this.head.add(current);
+      this.arrows = { template, current };
+    } else if (!on && this.arrows) {
+      this.scene.remove(this.arrows.template);
+      this.head.remove(this.arrows.current);
+      this.arrows = null;
+    }
+    this.requestRender();
   }
 
   dispose(): void {
@@ -184,6 +248,15 @@ export class FaceView {
  * flooding the 1-ring graph from the inner-lip contour outward and stopping at
  * the outer-lip contour, so it works for any template with those regions.
  */
+/** A blue -> cyan -> green -> yellow -> red ramp at t in [0, 1], written to out[at..at+3). */
+function heat(t: number, out: Float32Array, at: number): void {
+  const stops = [[0.12, 0.16, 0.45], [0.1, 0.65, 0.85], [0.25, 0.8, 0.3], [0.95, 0.85, 0.2], [0.85, 0.15, 0.12]];
+  const x = t * (stops.length - 1);
+  const k = Math.min(stops.length - 2, Math.floor(x));
+  const f = x - k;
+  for (let i = 0; i < 3; i++) out[at + i] = stops[k][i] * (1 - f) + stops[k + 1][i] * f;
+}
+
 function skinColors(t: FaceTemplate): Float32Array {
   const skin = new THREE.Color(SKIN_COLOR);
   const lip = new THREE.Color(LIP_COLOR);

@@ -126,6 +126,32 @@ describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
   });
 });
 
+describe('attention maps (the paper\'s Fig. 7 and Fig. 10)', () => {
+  it('the reference decoder\'s attention weights equal PyTorch\'s, for every layer', async () => {
+    const m = manifest.model.config;
+    const template = await decodeTemplate(JSON.parse(readFileSync(resolve(MODELS, manifest.template.path), 'utf8')), buf(manifest.template.path.replace('.json', '.bin')));
+    const weights = decoderWeights(parseSafetensors(buf(manifest.files.decoder_weights)).tensors, m);
+    const dec = new ReferenceDecoder(weights, template.adjacency, m);
+    const n = template.vertexCount;
+    for (let layer = 0; layer < m.layers; layer++) {
+      const maps = dec.attention(f32(fx, 'tokens'), f32(fx, 'pose_token'), layer);
+      expect(maxAbsDiff(maps.poseToken, f32(fx, `attention_pose${layer}`))).toBeLessThan(1e-5);
+      const table = f32(fx, `attention_vertex${layer}`);
+      const K = table.length / n;
+      let worst = 0;
+      for (let j = 0; j < n; j++) {
+        let sum = 0;
+        for (let s = 0; s < maps.keyStart[j + 1] - maps.keyStart[j]; s++) {
+          worst = Math.max(worst, Math.abs(maps.vertexWeights[maps.keyStart[j] + s] - table[j * K + s]));
+          sum += maps.vertexWeights[maps.keyStart[j] + s];
+        }
+        expect(sum).toBeCloseTo(1, 5);
+      }
+      expect(worst).toBeLessThan(1e-5);
+    }
+  });
+});
+
 describe('the fast decoder\'s kernels', () => {
   it('blocked matrix product equals the plain sum for every remainder of rows and outputs', () => {
     for (const [rows, outs, cols] of [[1, 1, 3], [2, 4, 5], [3, 6, 7], [5, 9, 16], [8, 3, 32]]) {

@@ -164,11 +164,14 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     pose_feat, _ = model.pose_encoder(mel_t)                                   # (1, K, d)
     pose_token = pose_feat[0, mel_index]                                       # (F, d)
     x = torch.cat([tokens, pose_token[:, None]], 1)
-    layers = []
+    layers, attention = [], {}
     h = x[:FIXTURE_TOKEN_FRAMES]
-    for block in model.decoder.blocks:
-        h, _ = block(h, "neighbour", model.nbr_table, model.nbr_pad)
+    for i, block in enumerate(model.decoder.blocks):
+        h, (w_pose, w_vert) = block(h, "neighbour", model.nbr_table, model.nbr_pad, return_attention=True)
         layers.append(h.numpy())
+        # Frame 0, mean over heads: the pose token's weights (N+1), and each vertex's over its key table (N, K).
+        attention[f"attention_pose{i}"] = w_pose[0].mean(0).numpy()
+        attention[f"attention_vertex{i}"] = w_vert[0].mean(1).masked_fill(model.nbr_pad, 0.0).numpy()
     offsets, pose, _ = model.decode(tokens, pose_token)
     tpl = torch.from_numpy(template_mm)
     from .model.geometry import apply_pose
@@ -181,6 +184,7 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     }
     for i, l in enumerate(layers):
         tensors[f"layer{i}"] = l
+    tensors.update(attention)
     out.mkdir(parents=True, exist_ok=True)
     write_safetensors(out / "fixtures.safetensors", tensors, {"frames": str(n_frames), "token_frames": str(FIXTURE_TOKEN_FRAMES)})
     return {"file": "fixtures/fixtures.safetensors", "frames": n_frames, "token_frames": FIXTURE_TOKEN_FRAMES,

@@ -1,0 +1,96 @@
+/**
+ * Export an animation as binary glTF (.glb) that standard viewers play: the neutral face as the mesh,
+ * one morph target per frame (that frame's I + O minus I), a weights track that steps through the
+ * frames, and the head pose as the node's rotation and translation. Also the raw per-frame vertices.
+ */
+import * as THREE from 'three';
+import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
+import type { Animation } from '../engine/engine';
+import type { FaceTemplate } from '../template/face-template';
+
+/** One morph target per frame makes the weights track frames x frames: cap the exported length. */
+export const GLB_MAX_FRAMES = 1800;
+
+export interface GlbExport {
+  bytes: ArrayBuffer;
+  frames: number;
+  truncated: boolean;
+}
+
+export async function exportGlb(animation: Animation, template: FaceTemplate, unitsPerMm: number, name = 'talking-face'): Promise<GlbExport> {
+  if (!animation.unposed) throw new Error('exportGlb: the animation has no unposed frames');
+  const frames = Math.min(animation.frames, GLB_MAX_FRAMES);
+  const n = template.vertexCount;
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(template.positions), 3));
+  geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
+  const targets: THREE.BufferAttribute[] = [];
+  for (let f = 0; f < frames; f++) {
+    const d = new Float32Array(n * 3);
+    for (let i = 0; i < n * 3; i++) d[i] = animation.unposed[f * n * 3 + i] - template.positions[i];
+    targets.push(new THREE.BufferAttribute(d, 3));
+  }
+  geometry.morphAttributes.position = targets;
+  geometry.morphTargetsRelative = true;
+  geometry.computeVertexNormals();
+  const mesh = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({ color: 0xe0ac8e, roughness: 0.6, side: THREE.DoubleSide }));
+  mesh.name = name;
+  mesh.updateMorphTargets();
+  const scene = new THREE.Scene();
+  scene.add(mesh);
+
+  const times = Float32Array.from({ length: frames }, (_, f) => f / animation.fps);
+  const weights = new Float32Array(frames * frames);
+  for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
+  const quats = new Float32Array(frames * 4);
+  const moves = new Float32Array(frames * 3);
+  const q = new THREE.Quaternion();
+  const axis = new THREE.Vector3();
+  for (let f = 0; f < frames; f++) {
+    const p = animation.pose.subarray(f * 6, f * 6 + 6);
+    const angle = Math.hypot(p[0], p[1], p[2]);
+    if (angle < 1e-9) q.identity();
+    else q.setFromAxisAngle(axis.set(p[0] / angle, p[1] / angle, p[2] / angle), angle);
+    q.toArray(quats, f * 4);
+    moves.set([p[3] * unitsPerMm, p[4] * unitsPerMm, p[5] * unitsPerMm], f * 3);
+  }
+  const clip = new THREE.AnimationClip('speech', (frames - 1) / animation.fps, [
+    new THREE.NumberKeyframeTrack(`${name}.morphTargetInfluences`, times, weights),
+    new THREE.QuaternionKeyframeTrack(`${name}.quaternion`, times, quats),
+    new THREE.VectorKeyframeTrack(`${name}.position`, times, moves),
+  ]);
+  const bytes = (await new GLTFExporter().parseAsync(scene, { binary: true, animations: [clip] })) as ArrayBuffer;
+  geometry.dispose();
+  (mesh.material as THREE.Material).dispose();
+  return { bytes, frames, truncated: frames < animation.frames };
+}
+
+/** Re-load a .glb with three.js: how many morph targets, animation clips and their duration. */
+export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number }> {
+  const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+  const gltf = await new GLTFLoader().parseAsync(bytes, '');
+  let mesh: THREE.Mesh | null = null;
+  gltf.scene.traverse((o) => {
+    if (!mesh && (o as THREE.Mesh).isMesh) mesh = o as THREE.Mesh;
+  });
+  const m = mesh as THREE.Mesh | null;
+  return {
+    morphTargets: m?.geometry.morphAttributes.position?.length ?? 0,
+    clips: gltf.animations.length,
+    duration: gltf.animations[0]?.duration ?? 0,
+    vertices: m?.geometry.getAttribute('position').count ?? 0,
+  };
+}
+
+/** The posed vertices, float32 little-endian, frames x N x 3, in the template's units. */
+export function rawFrames(animation: Animation): Blob {
+  return new Blob([animation.vertices.slice().buffer], { type: 'application/octet-stream' });
+}
+
+export function download(blob: Blob, filename: string): void {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = filename;
+  a.click();
+  setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+}

@@ -1,0 +1,75 @@
+import { test, expect, imageStats } from './fixtures';
+
+/**
+ * What the paper shows, on a sample clip of the test split with its ground truth: error heat map (Fig. 5),
+ * side by side with the ground truth, pose arrows (Fig. 1), attention maps (Fig. 7, Fig. 10); and the
+ * exports (.glb re-loaded with three.js; raw frames).
+ */
+type TF = {
+  take: { name: string; animation: { frames: number; fps: number }; truth?: { frames: number } } | null;
+  view: { scene: { getObjectByName(n: string): unknown } };
+  exportGlb(): Promise<{ bytes: ArrayBuffer; frames: number }>;
+  inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number }>;
+};
+
+test('sample clip: heat map, side by side, pose arrows, attention maps, exports', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#sample-select option')).toHaveCount(4); // "choose…" + the three samples
+  const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
+  await page.locator('#sample-select').selectOption(first!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#status')).toContainText(/E_vl on this clip: \d+\.\d\d mm/);
+  const take = await page.evaluate(() => ({ frames: (globalThis as unknown as { talkingFace: TF }).talkingFace.take!.animation.frames, truth: (globalThis as unknown as { talkingFace: TF }).talkingFace.take!.truth?.frames }));
+  expect(Math.abs(take.frames - take.truth!)).toBeLessThanOrEqual(1);
+
+  // Error heat map (Fig. 5).
+  const plain = await imageStats(page, await page.locator('#face-canvas').screenshot());
+  await page.locator('#paint-select').selectOption('error');
+  await expect(page.locator('#legend')).toContainText('5 mm');
+  const heat = await imageStats(page, await page.locator('#face-canvas').screenshot());
+  expect(heat.foregroundFraction).toBeGreaterThan(0.15);
+  expect(heat.distinctColours).not.toBe(plain.distinctColours);
+
+  // Side by side with the ground truth.
+  await page.locator('#side-check').check();
+  await expect(page.locator('#gt-view')).toBeVisible();
+  await page.locator('#scrub').fill('40');
+  const gt = await imageStats(page, await page.locator('#gt-canvas').screenshot());
+  expect(gt.foregroundFraction).toBeGreaterThan(0.1);
+  await test.info().attach('side-by-side.png', { body: await page.locator('#stage').screenshot(), contentType: 'image/png' });
+
+  // Pose arrows (Fig. 1).
+  await page.locator('#arrows-check').check();
+  expect(await page.evaluate(() => Boolean((globalThis as unknown as { talkingFace: TF }).talkingFace.view.scene.getObjectByName('pose_arrow_template')))).toBe(true);
+
+  // Attention maps (Fig. 7, Fig. 10), for the paused frame.
+  await page.locator('#paint-select').selectOption('pose-attention');
+  await expect(page.locator('body')).toHaveAttribute('data-painted', 'pose-attention', { timeout: 30_000 });
+  await expect(page.locator('#legend')).toContainText('Fig. 7');
+  await page.locator('#paint-select').selectOption('vertex-attention');
+  await expect(page.locator('body')).toHaveAttribute('data-painted', 'vertex-attention', { timeout: 30_000 });
+  const box = (await page.locator('#face-canvas').boundingBox())!;
+  await page.mouse.click(box.x + box.width / 2, box.y + box.height * 0.45);
+  await expect(page.locator('#legend')).toContainText(/Vertex \d+'s attention over itself and its \d+ neighbours/);
+  await test.info().attach('attention.png', { body: await page.locator('#stage').screenshot(), contentType: 'image/png' });
+
+  // .glb: re-loads in three.js with one morph target per frame and the clip's duration.
+  const glb = await page.evaluate(async () => {
+    const g = await (globalThis as unknown as { talkingFace: TF }).talkingFace.exportGlb();
+    return { frames: g.frames, info: await (globalThis as unknown as { talkingFace: TF }).talkingFace.inspectGlb(g.bytes) };
+  });
+  expect(glb.frames).toBe(take.frames);
+  expect(glb.info.morphTargets).toBe(take.frames);
+  expect(glb.info.clips).toBe(1);
+  expect(glb.info.vertices).toBe(468);
+  expect(glb.info.duration).toBeCloseTo((take.frames - 1) / 30, 3);
+
+  // Raw frames: float32 frames x N x 3.
+  const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-raw').click()]);
+  expect(download.suggestedFilename()).toBe(`${first}.${take.frames}x468x3.f32`);
+  const path = await download.path();
+  const { statSync } = await import('node:fs');
+  expect(statSync(path!).size).toBe(take.frames * 468 * 3 * 4);
+});
