@@ -88,6 +88,7 @@ async function main() {
   const whole = await engine.animate(audio);
   const chunked = await engine.animate(audio, { chunkFrames: 5 });
   result.engineFrames = whole.frames;
+  result.engineCpuThreads = engine.cpuThreads;
   result.engineCpuVsTorch = maxAbsDiff(whole.vertices, torchVertices);
   result.engineChunkedVsWhole = maxAbsDiff(chunked.vertices, whole.vertices);
 

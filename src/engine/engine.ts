@@ -16,6 +16,7 @@ import { contentWindows, softmaxRows } from '../model/windows';
 import { logMelFrames, melFrameCount } from '../audio/mel';
 import { ReferenceDecoder, applyPose, decoderWeights, type AttentionMaps, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { FastDecoder } from '../attention/fast-decoder';
+import { DecoderPool } from '../attention/decoder-pool';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { LiveSession, type LiveOptions } from './live';
 import { detectWebGPU, requestSharedDevice } from '../gpu/capabilities';
@@ -33,6 +34,11 @@ export interface EngineOptions {
   backend?: 'auto' | Backend;
   /** URL of the face template (default: the manifest's). It must be the template the model was trained on. */
   templateUrl?: string | URL;
+  /**
+   * Web Workers for the CPU decoder (default: one per core, up to 4; 0 or 1 decodes in the page's
+   * thread). Each chunk's frames are split between them; the numbers are the same either way.
+   */
+  cpuWorkers?: number;
   /** Execution providers for the ONNX encoders, in order of preference (default: webgpu then wasm on a hardware adapter, else wasm). */
   onnxProviders?: ExecutionProvider[];
   fetch?: typeof fetch;
@@ -113,6 +119,7 @@ export class TalkingFaceEngine {
   private gpu: GpuDecoder | null;
   private readonly cpu: FastDecoder;
   private reference: ReferenceDecoder | null = null;
+  private pool: DecoderPool | null = null;
   private readonly templateMm: Float32Array;
   private readonly mmPerUnit: number;
   backend: Backend;
@@ -201,6 +208,8 @@ export class TalkingFaceEngine {
       if (options.backend === 'webgpu' && !gpu) throw new ModelLoadError(`WebGPU was requested but is not available: ${reason}`);
     }
     const engine = new TalkingFaceEngine(manifest, template, content, hierarchical, poseConv, poseLstm, cpu, gpu, reason);
+    const cores = globalThis.navigator?.hardwareConcurrency ?? 1;
+    engine.pool = await DecoderPool.create(options.cpuWorkers ?? Math.min(4, cores), weights, template.adjacency, m);
     gpu?.device.lost.then((info) => engine.deviceLost(gpu, info));
     return engine;
   }
@@ -395,7 +404,21 @@ export class TalkingFaceEngine {
         this.backendReason = `WebGPU failed (${(e as Error).message}); using the CPU decoder`;
       }
     }
+    if (this.pool && frames > 1) {
+      try {
+        return await this.pool.decode(tokens, poseToken, frames);
+      } catch {
+        // A crashed worker: decode in this thread from now on (same numbers).
+        this.pool.terminate();
+        this.pool = null;
+      }
+    }
     return this.cpu.decode(tokens, poseToken, frames);
+  }
+
+  /** CPU decoder threads: the workers' count, or 1 when decoding in the page's thread. */
+  get cpuThreads(): number {
+    return this.pool?.size ?? 1;
   }
 
   /** A lost device (driver reset, GPU process crash): carry on with the CPU decoder. */

@@ -27,6 +27,7 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the 
   }
   // The whole engine against PyTorch's final vertices (template units: cm), chunked = whole, WebGPU = CPU.
   expect(r.engineFrames).toBe(18);
+  expect(r.engineCpuThreads, 'the CPU decoder ran on its worker pool (2 cores)').toBe(2);
   expect(r.engineCpuVsTorch as number).toBeLessThan(1e-4);
   expect(r.engineChunkedVsWhole as number).toBeLessThan(1e-5);
   expect(r.engineGpuVsCpu as number).toBeLessThan(1e-5);
