@@ -49,6 +49,31 @@ test.describe('the face viewer', () => {
   });
 });
 
+test('at phone width every control is reachable without sideways scrolling, and by keyboard', async ({ page }) => {
+  await page.setViewportSize({ width: 375, height: 740 });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(375);
+  for (const id of ['#record-button', '#sample-select', '#play-button', '#scrub', '#paint-select', '#export-glb']) {
+    const box = (await page.locator(id).boundingBox())!;
+    expect(box.x, id).toBeGreaterThanOrEqual(0);
+    expect(box.x + box.width, id).toBeLessThanOrEqual(376);
+  }
+  // Every control has an accessible name.
+  const unnamed = await page.evaluate(() => Array.from(document.querySelectorAll('button, input, select')).filter((el) => {
+    const e = el as HTMLInputElement;
+    return !(e.labels?.length || e.getAttribute('aria-label') || e.textContent?.trim());
+  }).map((el) => el.id));
+  expect(unnamed).toEqual([]);
+  // Keyboard: tab reaches the record button and Enter presses it (no microphone here: a message, not a hang).
+  await page.locator('#file-input').focus();
+  await page.keyboard.press('Tab');
+  await expect(page.locator('#record-button')).toBeFocused();
+  await page.keyboard.press('Enter');
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'error', { timeout: 20_000 });
+  expect((await imageStats(page, await page.locator('#face-canvas').screenshot())).foregroundFraction).toBeGreaterThan(0.1);
+});
+
 test('reports a missing template in the page instead of a blank screen', async ({ page, guard }) => {
   guard.allowConsoleError(/404|could not load the face template/i);
   await page.route('**/models/template/template.json', (route) => route.fulfill({ status: 404, body: 'gone' }));
