@@ -27,6 +27,26 @@ test('record: the face follows the microphone live, then the take replays in syn
   const gaps = await lipGaps(page);
   expect(gaps.length).toBeGreaterThan(60);
   expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth opens and closes (mm)').toBeGreaterThan(2);
+  // ... in time with the speech: the lip gap follows the loudness of the take (best over a lag of +-100 ms).
+  const envelope = await page.evaluate(() => {
+    const take = (globalThis as unknown as { talkingFace: { take: { samples: Float32Array; animation: { frames: number } } } }).talkingFace.take;
+    const per = 16000 / 30;
+    return Array.from({ length: take.animation.frames }, (_, f) => {
+      let e = 0;
+      const a = Math.max(0, Math.round((f - 0.5) * per)), b = Math.min(take.samples.length, Math.round((f + 0.5) * per));
+      for (let i = a; i < b; i++) e += take.samples[i] ** 2;
+      return Math.sqrt(e / Math.max(1, b - a));
+    });
+  });
+  const corr = (x: number[], y: number[]) => {
+    const mx = x.reduce((s, v) => s + v, 0) / x.length, my = y.reduce((s, v) => s + v, 0) / y.length;
+    let sxy = 0, sxx = 0, syy = 0;
+    for (let i = 0; i < x.length; i++) { sxy += (x[i] - mx) * (y[i] - my); sxx += (x[i] - mx) ** 2; syy += (y[i] - my) ** 2; }
+    return sxy / Math.sqrt(sxx * syy);
+  };
+  const lagged = [-3, -2, -1, 0, 1, 2, 3].map((lag) => corr(gaps.slice(Math.max(0, lag), gaps.length + Math.min(0, lag)), envelope.slice(Math.max(0, -lag), envelope.length - Math.max(0, lag))));
+  console.log(`lip gap vs loudness: correlation ${lagged.map((c) => c.toFixed(2)).join(' ')} at lags -3..3 frames`);
+  expect(Math.max(...lagged), 'lip gap follows the speech').toBeGreaterThan(0.3);
   await page.locator('#play-button').click();
   await expect(page.locator('#play-button')).toHaveText('Pause');
   await expect.poll(() => page.locator('#scrub').inputValue(), { timeout: 10_000 }).not.toBe('0');
