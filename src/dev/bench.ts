@@ -39,6 +39,7 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   let t = now();
   const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
   result.model_load_ms = now() - t;
+  result.cpu_decoder_threads = engine.cpuThreads;
   const bytes = await Promise.all(engine.manifest.runtime_files.map(async (k) => (await fetch(`/models/${engine.manifest.files[k]}`)).arrayBuffer()));
   result.model_bytes = bytes.reduce((s, b) => s + b.byteLength, 0);
   const rate = engine.manifest.audio.sample_rate;
@@ -48,7 +49,11 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   for (const backend of backends) {
     if (backend === 'webgpu' && !gpu.adapter) continue;
     await engine.setBackend(backend);
-    for (const seconds of clipSeconds) {
+    // The first clip after loading pays for compiling (JIT in the page and the decoder workers, shader
+    // pipelines): run it as its own "cold" row; the timed rows after it are the steady state.
+    for (let seconds of [0, ...clipSeconds]) {
+      const cold = seconds === 0;
+      if (cold) seconds = backend === 'cpu' ? clipSeconds[0] : 2; // (a software GPU only needs its pipelines compiled)
       if (backend === 'webgpu' && seconds > 10 && gpu.info?.isFallbackAdapter) continue; // software GPU: 10 s is enough to report
       const audio = speechOf(seconds, wav.samples, rate);
       engine.resetTimes();
@@ -63,9 +68,10 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
         },
       });
       const wall = now() - t;
-      stages[`${backend}_${seconds}s`] = { wall_ms: wall, rtf: seconds / (wall / 1000), first_frame_ms: first, peak_heap_bytes: peak, stages_ms: { ...engine.times } };
-      result[`rtf_${backend === 'webgpu' ? 'webgpu' : 'cpu'}_${seconds}s`] = seconds / (wall / 1000);
-      if (backend === 'cpu' && seconds === clipSeconds[0]) result.first_frame_ms = first;
+      const name = `${backend}_${seconds}s${cold ? '_cold' : ''}`;
+      stages[name] = { wall_ms: wall, rtf: seconds / (wall / 1000), first_frame_ms: first, peak_heap_bytes: peak, stages_ms: { ...engine.times } };
+      result[`rtf_${backend === 'webgpu' ? 'webgpu' : 'cpu'}_${seconds}s${cold ? '_cold' : ''}`] = seconds / (wall / 1000);
+      if (backend === 'cpu' && cold) result.first_frame_ms = first; // what a visitor waits for on the first clip
     }
   }
   result.runs = stages;
