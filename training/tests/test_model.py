@@ -38,8 +38,9 @@ def test_augmented_adjacency_mask(template):
 
 def test_neighbour_attention_equals_the_dense_formula(template):
     model = make(template)
-    x = torch.randn(3, template.num_vertices, 64)
-    p = torch.randn(3, 64)
+    d = model.cfg.d_model
+    x = torch.randn(3, template.num_vertices, d)
+    p = torch.randn(3, d)
     with torch.no_grad():
         a = model.decode(x, p)
         b = model.decode(x, p, dense=True)
@@ -67,10 +68,11 @@ def test_gava_information_travels_one_ring_per_layer(template):
     depends on the pose token; plain self-attention (SA) spreads everywhere."""
     n, v = template.num_vertices, 13
     dist = hops_from(template, v)
-    x = torch.randn(1, n, 64)
-    p = torch.randn(1, 64)
+    d = ModelConfig().d_model
+    x = torch.randn(1, n, d)
+    p = torch.randn(1, d)
     x2 = x.clone()
-    x2[0, v] += torch.randn(64)  # not a constant shift: LayerNorm would remove that before attention sees it
+    x2[0, v] += torch.randn(d)  # not a constant shift: LayerNorm would remove that before attention sees it
     model = make(template)
 
     def tokens_out(m, x, p):  # the decoder's output tokens (the heads are per token; the pose head starts at zero)
@@ -78,7 +80,7 @@ def test_gava_information_travels_one_ring_per_layer(template):
     with torch.no_grad():
         out0 = tokens_out(model, x, p)
         out1 = tokens_out(model, x2, p)
-        out2 = tokens_out(model, x, p + torch.randn(64))
+        out2 = tokens_out(model, x, p + torch.randn(d))
     base, moved, other_pose = out0[:, :n], out1[:, :n], out2[:, :n]
     pose0, pose1 = out0[:, n], out1[:, n]
     change = (moved - base).abs().amax(-1)[0]
