@@ -52,8 +52,8 @@ test.describe('animating an audio file', () => {
   });
 
   test('a silent recording is animated and reported as silent', async ({ page }) => {
-    // (That the mouth then stays closed is the issue-6 requirement the shipped model does not meet yet:
-    // it leaves the lips about 4 mm apart in silence; see docs/results/default.md.)
+    // (That the mouth then stays closed is checked, and known to fail, in live-silence.spec.ts: the shipped
+    // model leaves the lips about 1.6 mm apart in silence; see docs/results/default.md.)
     await page.locator('#file-input').setInputFiles({ name: 'silence.wav', mimeType: 'audio/wav', buffer: silentWav(2) });
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
     await expect(page.locator('#status')).toContainText('silent');
