@@ -19,6 +19,14 @@ export const CHROMIUM_ARGS = [
   '--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE localhost , EXCLUDE 127.0.0.1',
 ];
 
+/** Chromium launch options with a fake microphone that plays `wav` (and grants it without a prompt). */
+export function fakeMicrophone(wav: string): { executablePath: string; args: string[] } {
+  return {
+    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
+    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${wav}`],
+  };
+}
+
 export default defineConfig({
   testDir: 'tests/e2e',
   timeout: 60_000,

@@ -6,7 +6,7 @@ import { chromium, type Page } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
 import { mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { CHROMIUM_ARGS } from '../playwright.config';
+import { fakeMicrophone } from '../playwright.config';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const OUT = resolve(ROOT, 'docs/screenshots');
@@ -31,10 +31,7 @@ async function main(): Promise<void> {
       }
     }
     const wav = resolve(ROOT, 'tests/fixtures/speech-kal.wav');
-    const browser = await chromium.launch({
-      executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
-      args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${wav}`],
-    });
+    const browser = await chromium.launch(fakeMicrophone(wav));
     const page = await browser.newPage({ viewport: { width: 1100, height: 760 } });
     await page.goto(`${URL_}/`);
     await ready(page, 'engine', 'ready');

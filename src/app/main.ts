@@ -3,7 +3,7 @@
  * an audio file the visitor opens or drops, or the microphone live while they speak; and plays the take
  * back with the face in sync (play, pause, scrub, loop).
  */
-import { loadTemplate } from '../template/face-template';
+import { loadTemplate, lipMask as lipMaskOf } from '../template/face-template';
 import { FaceView } from '../render/face-view';
 import { detectWebGPU } from '../gpu/capabilities';
 import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
@@ -192,12 +192,14 @@ function setTake(t: Take, notes: string[] = []): void {
 }
 
 /** Frame f of the prediction as drawn: on the sample subject's own face when there is ground truth. */
+let predictedScratch = new Float32Array(0);
 function predictedFrame(f: number): Float32Array {
   const n3 = view.template.vertexCount * 3;
   const u = take!.animation.unposed!.subarray(f * n3, (f + 1) * n3);
   const truth = take!.truth;
   if (!truth) return u;
-  const out = new Float32Array(n3);
+  if (predictedScratch.length !== n3) predictedScratch = new Float32Array(n3); // reused: callers use it at once
+  const out = predictedScratch;
   for (let i = 0; i < n3; i++) out[i] = truth.template[i] + u[i] - view.template.positions[i];
   return out;
 }
@@ -303,27 +305,6 @@ function clipLipError(): number {
   return sum / frames;
 }
 
-/** Lip vertices: flood the 1-ring graph from the inner-lip contour to the outer one (as training's metrics). */
-function lipRegion(): Uint8Array {
-  const t = view.template;
-  const mask = new Uint8Array(t.vertexCount);
-  const outer = new Set(t.regions.lips_outer);
-  const queue = [...t.regions.lips_inner_upper, ...t.regions.lips_inner_lower];
-  for (const v of queue) mask[v] = 1;
-  while (queue.length) {
-    const v = queue.pop()!;
-    if (outer.has(v)) continue;
-    for (let k = t.adjacency.offsets[v]; k < t.adjacency.offsets[v + 1]; k++) {
-      const w = t.adjacency.indices[k];
-      if (!mask[w]) {
-        mask[w] = 1;
-        queue.push(w);
-      }
-    }
-  }
-  return mask;
-}
-
 async function loadSampleIndex(): Promise<void> {
   try {
     const res = await fetch(SAMPLES_URL);
@@ -366,7 +347,7 @@ async function openSample(name: string): Promise<void> {
     const n = view.template.vertexCount;
     if (c.vertices !== n) throw new Error(`the sample has ${c.vertices} vertices, the face ${n}`);
     const truth = decodeTruth(truthBytes, n, c.frames, e.unitsPerMm);
-    lipMask ??= lipRegion();
+    lipMask ??= lipMaskOf(view.template);
     const audio = await decodeAudio(audioBytes, e.manifest.audio.sample_rate);
     e.resetTimes();
     const t0 = performance.now();
@@ -377,7 +358,6 @@ async function openSample(name: string): Promise<void> {
     });
     clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}"`;
     setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: c.name, seconds: c.seconds, computeMs: performance.now() - t0, backend: e.backend, truth });
-    lipMask ??= lipRegion();
     take!.lipError = clipLipError();
     showStatus(`${status.textContent} E_vl on this clip: ${take!.lipError.toFixed(2)} mm.`);
   } catch (err) {

@@ -36,9 +36,20 @@ export class DecoderPool {
     }
   }
 
-  /** Start `size` workers with the decoder's weights; null if workers cannot run here. */
+  /** Why the last create() returned null (for the engine's status), or null. */
+  static lastFailure: string | null = null;
+
+  /** Start `size` workers with the decoder's weights; null (and `lastFailure` says why) if workers cannot run here. */
   static async create(size: number, weights: DecoderWeights, adjacency: Adjacency, m: ModelConstants): Promise<DecoderPool | null> {
-    if (typeof Worker === 'undefined' || size < 2) return null;
+    DecoderPool.lastFailure = null;
+    if (typeof Worker === 'undefined') {
+      DecoderPool.lastFailure = 'no Web Workers here';
+      return null;
+    }
+    if (size < 2) {
+      DecoderPool.lastFailure = `one decoder thread asked for (${size})`;
+      return null;
+    }
     const workers: Worker[] = [];
     try {
       for (let i = 0; i < size; i++) {
@@ -58,8 +69,9 @@ export class DecoderPool {
         };
         w.postMessage({ type: 'init', weights, adjacency, constants: m });
       })));
-    } catch {
+    } catch (e) {
       for (const w of workers) w.terminate();
+      DecoderPool.lastFailure = (e as Error).message;
       return null;
     }
     return new DecoderPool(workers, adjacency.offsets.length - 1, m.d_model);

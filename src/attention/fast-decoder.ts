@@ -13,7 +13,7 @@
  */
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
-import type { DecodeResult, DecoderWeights } from './reference';
+import { keyLists, type DecodeResult, type DecoderWeights } from './reference';
 
 const LN_EPS = 1e-5;
 
@@ -166,18 +166,9 @@ export class FastDecoder {
     this.attn = new Float32Array(T * this.d);
     this.hidden = new Float32Array(T * m.ffn);
     this.scores = new Float64Array(T);
-    const { offsets: ro, indices: ri } = adjacency;
-    this.keyStart = new Int32Array(T + 1);
-    this.keyIndex = new Int32Array(n + ri.length + T);
-    let k = 0;
-    for (let t = 0; t < n; t++) {
-      this.keyStart[t] = k;
-      this.keyIndex[k++] = t;
-      for (let e = ro[t]; e < ro[t + 1]; e++) this.keyIndex[k++] = ri[e];
-    }
-    this.keyStart[n] = k;
-    for (let s = 0; s < T; s++) this.keyIndex[k++] = s;
-    this.keyStart[T] = k;
+    const lists = keyLists(adjacency, true);
+    this.keyStart = lists.keyStart;
+    this.keyIndex = lists.keys;
   }
 
   /** tokens (F x N x d), poseToken (F x d) -> displacement (F x N x 3, mm) and pose (F x 6) per frame. */

@@ -91,6 +91,30 @@ export interface DecodeResult {
   pose: Float32Array; // (F x 6) axis-angle (rad), translation (mm)
 }
 
+/**
+ * The keys each token attends to, as one CSR list: vertex t -> [t, its 1-ring...] (the augmented
+ * adjacency M~); with `poseToken`, token N (the pose token) -> every token 0..N.
+ */
+export function keyLists(adjacency: Adjacency, poseToken: boolean): { keyStart: Int32Array; keys: Int32Array } {
+  const { offsets: ro, indices: ri } = adjacency;
+  const n = ro.length - 1;
+  const T = poseToken ? n + 1 : n;
+  const keyStart = new Int32Array(T + 1);
+  const keys = new Int32Array(n + ri.length + (poseToken ? T : 0));
+  let k = 0;
+  for (let t = 0; t < n; t++) {
+    keyStart[t] = k;
+    keys[k++] = t;
+    for (let e = ro[t]; e < ro[t + 1]; e++) keys[k++] = ri[e];
+  }
+  if (poseToken) {
+    keyStart[n] = k;
+    for (let s = 0; s < T; s++) keys[k++] = s;
+  }
+  keyStart[T] = k;
+  return { keyStart, keys };
+}
+
 /** Attention weights of one layer for one frame (averaged over heads), for the paper's Fig. 7 and Fig. 10. */
 export interface AttentionMaps {
   layer: number;
@@ -133,15 +157,7 @@ export class ReferenceDecoder {
   /** The attention weights of `layer` (0-based) when decoding frame 0 of tokens / poseToken. */
   attention(tokens: Float32Array, poseToken: Float32Array, layer: number): AttentionMaps {
     const n = this.n;
-    const { offsets: ro, indices: ri } = this.adjacency;
-    const keyStart = new Int32Array(n + 1);
-    const keys = new Int32Array(n + ri.length);
-    for (let j = 0, k = 0; j < n; j++) {
-      keyStart[j] = k;
-      keys[k++] = j;
-      for (let e = ro[j]; e < ro[j + 1]; e++) keys[k++] = ri[e];
-      keyStart[j + 1] = k;
-    }
+    const { keyStart, keys } = keyLists(this.adjacency, false);
     this.capture = { layer, poseToken: new Float32Array(n + 1), vertexWeights: new Float32Array(keys.length), keyStart, keys };
     try {
       this.decode(tokens, poseToken, 1);

@@ -210,6 +210,7 @@ export class TalkingFaceEngine {
     const engine = new TalkingFaceEngine(manifest, template, content, hierarchical, poseConv, poseLstm, cpu, gpu, reason);
     const cores = globalThis.navigator?.hardwareConcurrency ?? 1;
     engine.pool = await DecoderPool.create(options.cpuWorkers ?? Math.min(4, cores), weights, template.adjacency, m);
+    if (!engine.pool && cores > 1 && options.cpuWorkers === undefined) engine.backendReason += `; CPU decoder in the page's thread (${DecoderPool.lastFailure})`;
     gpu?.device.lost.then((info) => engine.deviceLost(gpu, info));
     return engine;
   }
@@ -407,10 +408,11 @@ export class TalkingFaceEngine {
     if (this.pool && frames > 1) {
       try {
         return await this.pool.decode(tokens, poseToken, frames);
-      } catch {
-        // A crashed worker: decode in this thread from now on (same numbers).
+      } catch (e) {
+        // A crashed worker: decode in this thread from now on (same numbers), and say so.
         this.pool.terminate();
         this.pool = null;
+        this.backendReason += `; the decoder workers failed (${(e as Error).message}), decoding in the page's thread`;
       }
     }
     return this.cpu.decode(tokens, poseToken, frames);

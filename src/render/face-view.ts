@@ -8,7 +8,7 @@
  */
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import type { FaceTemplate } from '../template/face-template';
+import { lipMask, type FaceTemplate } from '../template/face-template';
 
 const SKIN_COLOR = 0xe0ac8e;
 const EYE_COLOR = 0xf4f1ec;
@@ -262,21 +262,7 @@ function skinColors(t: FaceTemplate): Float32Array {
   const lip = new THREE.Color(LIP_COLOR);
   const colors = new Float32Array(t.vertexCount * 3);
   for (let v = 0; v < t.vertexCount; v++) skin.toArray(colors, 3 * v);
-  const outer = new Set(t.regions.lips_outer);
-  const isLip = new Uint8Array(t.vertexCount);
-  const queue = [...t.regions.lips_inner_upper, ...t.regions.lips_inner_lower];
-  for (const v of queue) isLip[v] = 1;
-  while (queue.length) {
-    const v = queue.pop()!;
-    if (outer.has(v)) continue;
-    for (let k = t.adjacency.offsets[v]; k < t.adjacency.offsets[v + 1]; k++) {
-      const w = t.adjacency.indices[k];
-      if (!isLip[w]) {
-        isLip[w] = 1;
-        queue.push(w);
-      }
-    }
-  }
+  const isLip = lipMask(t);
   for (let v = 0; v < t.vertexCount; v++) if (isLip[v]) lip.toArray(colors, 3 * v);
   return colors;
 }

@@ -233,3 +233,26 @@ async function sha256Hex(bytes: Uint8Array): Promise<string> {
   const digest = await crypto.subtle.digest('SHA-256', bytes as Uint8Array<ArrayBuffer>);
   return Array.from(new Uint8Array(digest), (b) => b.toString(16).padStart(2, '0')).join('');
 }
+
+/**
+ * The lip surface as a per-vertex mask: flood the 1-ring graph from the inner-lip contours out to the
+ * outer-lip contour (the same region as training's metrics.lip_region, used for E_vl).
+ */
+export function lipMask(t: FaceTemplate): Uint8Array {
+  const mask = new Uint8Array(t.vertexCount);
+  const outer = new Set(t.regions.lips_outer);
+  const queue = [...t.regions.lips_inner_upper, ...t.regions.lips_inner_lower];
+  for (const v of queue) mask[v] = 1;
+  while (queue.length) {
+    const v = queue.pop()!;
+    if (outer.has(v)) continue;
+    for (let k = t.adjacency.offsets[v]; k < t.adjacency.offsets[v + 1]; k++) {
+      const w = t.adjacency.indices[k];
+      if (!mask[w]) {
+        mask[w] = 1;
+        queue.push(w);
+      }
+    }
+  }
+  return mask;
+}

@@ -1,18 +1,13 @@
 import { resolve } from 'node:path';
 import { test, expect, imageStats } from './fixtures';
-import { CHROMIUM_ARGS } from '../../playwright.config';
+import { fakeMicrophone } from '../../playwright.config';
 
 /**
  * <talking-face> from the library build in a plain HTML page (examples/embed.html): two instances at
  * once, one speaking a file while the other animates the (fake) microphone; events; a bad model URL.
  */
 const WAV = resolve(import.meta.dirname, '../fixtures/speech-kal.wav');
-test.use({
-  launchOptions: {
-    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
-    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${WAV}`],
-  },
-});
+test.use({ launchOptions: fakeMicrophone(WAV) });
 
 type FaceEl = HTMLElement & { speak(a: string): Promise<void>; startMicrophone(): Promise<void>; stop(): void; currentAnimation: { frames: number } | null; backend: string | null };
 

@@ -1,7 +1,7 @@
 import { writeFileSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
-import { CHROMIUM_ARGS } from '../../playwright.config';
+import { fakeMicrophone } from '../../playwright.config';
 import { wav, lipGaps } from './helpers/audio';
 
 /** A silent microphone (Chromium's fake device playing a silent WAV): the mouth stays closed. */
@@ -10,12 +10,7 @@ mkdirSync(DIR, { recursive: true });
 const SILENT = resolve(DIR, 'silence-16k.wav');
 writeFileSync(SILENT, wav([new Float32Array(16000 * 4)], 16000));
 
-test.use({
-  launchOptions: {
-    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
-    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${SILENT}`],
-  },
-});
+test.use({ launchOptions: fakeMicrophone(SILENT) });
 
 test('live from a silent microphone: the mouth stays closed', async ({ page }) => {
   test.setTimeout(120_000);

@@ -1,6 +1,6 @@
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
-import { CHROMIUM_ARGS } from '../../playwright.config';
+import { fakeMicrophone } from '../../playwright.config';
 
 /**
  * Live capture through the engine: Chromium's fake microphone plays tests/fixtures/speech-kal.wav into
@@ -8,12 +8,7 @@ import { CHROMIUM_ARGS } from '../../playwright.config';
  * offline animation of the captured take, and the lips must move with the speech.
  */
 const WAV = resolve(import.meta.dirname, '../fixtures/speech-kal.wav');
-test.use({
-  launchOptions: {
-    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
-    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${WAV}`],
-  },
-});
+test.use({ launchOptions: fakeMicrophone(WAV) });
 
 test('microphone -> worklet -> streaming engine: frames equal the offline animation of the take', async ({ page }) => {
   await page.goto('/dev/live.html?seconds=3');

@@ -1,14 +1,9 @@
 import { test, expect, imageStats } from './fixtures';
-import { CHROMIUM_ARGS } from '../../playwright.config';
+import { fakeMicrophone } from '../../playwright.config';
 import { SPEECH, lipGaps } from './helpers/audio';
 
 /** The demo's Record button with Chromium's fake microphone playing tests/fixtures/speech-kal.wav. */
-test.use({
-  launchOptions: {
-    executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium',
-    args: [...CHROMIUM_ARGS, '--use-fake-ui-for-media-stream', '--use-fake-device-for-media-stream', `--use-file-for-fake-audio-capture=${SPEECH}`],
-  },
-});
+test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
 test('record: the face follows the microphone live, then the take replays in sync', async ({ page }) => {
   test.setTimeout(120_000);
