@@ -28,7 +28,7 @@ const backends = opt('--backends', 'cpu,webgpu').split(',');
 const PORT = 4191;
 
 /** The parts of the engine that run the same in Node (no Web Audio, no WebGPU): Mel and the CPU decoders. */
-async function nodeBench(): Promise<Record<string, number>> {
+async function nodeBench(): Promise<Record<string, number | string>> {
   const models = resolve(ROOT, 'models');
   const bytes = (p: string) => {
     const b = readFileSync(resolve(models, p));
@@ -54,17 +54,24 @@ async function nodeBench(): Promise<Record<string, number>> {
   const tokens = Float32Array.from({ length: frames * n * m.d_model }, (_, i) => Math.sin(i * 0.37));
   const poseTok = Float32Array.from({ length: frames * m.d_model }, (_, i) => Math.cos(i * 0.11));
   const fast = new FastDecoder(weights, template.adjacency, m);
+  const fastJs = new FastDecoder(weights, template.adjacency, m, 'js');
   const reference = new ReferenceDecoder(weights, template.adjacency, m);
   return {
     mel_ms_per_audio_second: time(() => logMelFrames(samples, manifest.audio, 0, K)) / seconds,
     mel_meyda_extract_ms_per_audio_second: time(() => logMelFramesMeyda(samples, manifest.audio, 0, K), 1) / seconds,
     decoder_ms_per_frame: time(() => fast.decode(tokens, poseTok, frames)) / frames,
+    decoder_kernel: fast.kernelName,
+    decoder_js_ms_per_frame: time(() => fastJs.decode(tokens, poseTok, frames)) / frames,
     reference_decoder_ms_per_frame: time(() => reference.decode(tokens, poseTok, 4), 1) / 4,
   };
 }
 
 async function main(): Promise<void> {
   const node = await nodeBench();
+  if (process.argv.includes('--node-only')) {
+    console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
+    return;
+  }
   execSync('npm run --silent build', { cwd: ROOT, stdio: 'inherit' });
   const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
   try {

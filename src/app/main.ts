@@ -116,7 +116,7 @@ async function start(): Promise<void> {
     autoBackend = engine.backend;
     if (!gpu.available) backendSelect.querySelector<HTMLOptionElement>('option[value="webgpu"]')!.disabled = true;
     publish();
-    showStatus(`${baseStatus} Model ${engine.manifest.model.name} ready. Decoder: ${engine.backend} (${engine.backendReason}). Open or drop an audio file, or record.`);
+    showStatus(`${baseStatus} Model ${engine.manifest.model.name} ready. Decoder: ${engine.backend} (${engine.backendReason}; CPU decoder: ${engine.cpuKernel === 'wasm-simd' ? 'WebAssembly SIMD' : 'JavaScript'} on ${engine.cpuThreads} thread${engine.cpuThreads > 1 ? 's' : ''}). Open or drop an audio file, or record.`);
     document.body.dataset.engine = 'ready';
     void loadSampleIndex();
   } catch (e) {

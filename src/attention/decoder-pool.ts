@@ -22,6 +22,8 @@ export class DecoderPool {
     private readonly workers: Worker[],
     private readonly n: number,
     private readonly d: number,
+    /** The workers' decoder arithmetic ('wasm-simd' or 'js'). */
+    readonly kernel: string,
   ) {
     for (const w of workers) {
       w.onmessage = (e: MessageEvent<{ type: string; id: number; offsets?: Float32Array; pose?: Float32Array; message?: string }>) => {
@@ -51,6 +53,7 @@ export class DecoderPool {
       return null;
     }
     const workers: Worker[] = [];
+    const kernels: string[] = [];
     try {
       for (let i = 0; i < size; i++) {
         workers.push(new Worker(new URL('./decoder-worker.ts', import.meta.url), { type: 'module', name: `gava-decoder-${i}` }));
@@ -60,6 +63,7 @@ export class DecoderPool {
         w.onmessage = (e) => {
           if (e.data?.type === 'ready') {
             clearTimeout(timer);
+            kernels.push(e.data.kernel);
             resolve();
           }
         };
@@ -74,7 +78,7 @@ export class DecoderPool {
       DecoderPool.lastFailure = (e as Error).message;
       return null;
     }
-    return new DecoderPool(workers, adjacency.offsets.length - 1, m.d_model);
+    return new DecoderPool(workers, adjacency.offsets.length - 1, m.d_model, kernels[0]);
   }
 
   get size(): number {

@@ -29,7 +29,7 @@ self.onmessage = (e: MessageEvent<Init | Job>) => {
   try {
     if (msg.type === 'init') {
       decoder = new FastDecoder(msg.weights, msg.adjacency, msg.constants);
-      self.postMessage({ type: 'ready' });
+      self.postMessage({ type: 'ready', kernel: decoder.kernelName });
       return;
     }
     if (!decoder) throw new Error('decoder worker: decode before init');

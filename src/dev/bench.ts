@@ -40,6 +40,7 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
   result.model_load_ms = now() - t;
   result.cpu_decoder_threads = engine.cpuThreads;
+  result.cpu_decoder_kernel = engine.cpuKernel;
   const bytes = await Promise.all(engine.manifest.runtime_files.map(async (k) => (await fetch(`/models/${engine.manifest.files[k]}`)).arrayBuffer()));
   result.model_bytes = bytes.reduce((s, b) => s + b.byteLength, 0);
   const rate = engine.manifest.audio.sample_rate;

@@ -44,9 +44,11 @@ async function main() {
     result.gpuRepeatable = maxAbsDiff(again.offsets, g.offsets) === 0;
     dec.destroy();
   }
-  const fast = new FastDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
-  result.fastVsCpuOffsets = maxAbsDiff(fast.offsets, cpu.offsets);
-  result.fastVsCpuPose = maxAbsDiff(fast.pose, cpu.pose);
+  for (const kernel of ['wasm-simd', 'js'] as const) {
+    const fast = new FastDecoder(weights, template.adjacency, m, kernel).decode(tokens, poseTok, frames);
+    result[`fast_${kernel}_VsCpuOffsets`] = maxAbsDiff(fast.offsets, cpu.offsets);
+    result[`fast_${kernel}_VsCpuPose`] = maxAbsDiff(fast.pose, cpu.pose);
+  }
   result.cpuVsTorchOffsets = maxAbsDiff(cpu.offsets, f32(fx, 'offsets'));
 
   // The ONNX encoders on onnxruntime-web, on each execution provider, against PyTorch.
@@ -89,6 +91,7 @@ async function main() {
   const chunked = await engine.animate(audio, { chunkFrames: 5 });
   result.engineFrames = whole.frames;
   result.engineCpuThreads = engine.cpuThreads;
+  result.engineCpuKernel = engine.cpuKernel;
   result.engineCpuVsTorch = maxAbsDiff(whole.vertices, torchVertices);
   result.engineChunkedVsWhole = maxAbsDiff(chunked.vertices, whole.vertices);
 

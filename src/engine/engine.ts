@@ -423,6 +423,11 @@ export class TalkingFaceEngine {
     return this.pool?.size ?? 1;
   }
 
+  /** The CPU decoder's arithmetic: 'wasm-simd' (WebAssembly SIMD) or 'js' (TypeScript, where SIMD is missing). */
+  get cpuKernel(): string {
+    return this.pool?.kernel ?? this.cpu.kernelName;
+  }
+
   /** A lost device (driver reset, GPU process crash): carry on with the CPU decoder. */
   private deviceLost(decoder: GpuDecoder, info: GPUDeviceLostInfo): void {
     if (this.gpu !== decoder) return;

@@ -4,7 +4,7 @@ import { test, expect } from './fixtures';
  * The WGSL GAVA decoder in headless Chromium (WebGPU on SwiftShader, software but exact) against the
  * TypeScript reference and against PyTorch, on the exporter's fixture tokens (dev/parity.html).
  */
-test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the whole engine = PyTorch', async ({ page }) => {
+test('WGSL decoder = TypeScript reference = fast CPU decoder (WebAssembly SIMD and TypeScript) = PyTorch, and the whole engine = PyTorch', async ({ page }) => {
   await page.goto('/dev/parity.html');
   const result = await page.waitForFunction(() => (globalThis as unknown as { parityResult?: unknown }).parityResult, null, { timeout: 60_000 });
   const r = (await result.jsonValue()) as Record<string, number | boolean | string | { architecture: string } | null>;
@@ -13,8 +13,10 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the 
   expect(r.gpuVsCpuOffsets as number).toBeLessThan(1e-4);
   expect(r.gpuVsCpuPose as number).toBeLessThan(1e-5);
   expect(r.gpuVsTorchOffsets as number).toBeLessThan(1e-4);
-  expect(r.fastVsCpuOffsets as number).toBeLessThan(1e-4);
-  expect(r.fastVsCpuPose as number).toBeLessThan(1e-5);
+  for (const kernel of ['wasm-simd', 'js']) {
+    expect(r[`fast_${kernel}_VsCpuOffsets`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-4);
+    expect(r[`fast_${kernel}_VsCpuPose`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-5);
+  }
   expect(r.cpuVsTorchOffsets as number).toBeLessThan(1e-4);
   expect(r.cpuVsTorchPose as number).toBeLessThan(1e-5);
   expect(r.gpuRepeatable).toBe(true);
@@ -28,6 +30,7 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder = PyTorch, and the 
   // The whole engine against PyTorch's final vertices (template units: cm), chunked = whole, WebGPU = CPU.
   expect(r.engineFrames).toBe(18);
   expect(r.engineCpuThreads, 'the CPU decoder ran on its worker pool (2 cores)').toBe(2);
+  expect(r.engineCpuKernel, 'the workers decode in WebAssembly SIMD').toBe('wasm-simd');
   expect(r.engineCpuVsTorch as number).toBeLessThan(1e-4);
   expect(r.engineChunkedVsWhole as number).toBeLessThan(1e-5);
   expect(r.engineGpuVsCpu as number).toBeLessThan(1e-5);

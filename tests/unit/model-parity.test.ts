@@ -13,9 +13,12 @@ import { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from '../../sr
 import { contentWindows, softmaxRows } from '../../src/model/windows';
 import { ReferenceDecoder, applyPose, decoderWeights, gelu } from '../../src/attention/reference';
 import { FastDecoder, geluInPlace, matmulRows } from '../../src/attention/fast-decoder';
+import { jsKernel, SimdKernel } from '../../src/attention/decoder-kernels';
+import { assemble, generatedSource, KERNELS } from '../../scripts/build-wasm';
 import { decodeTemplate } from '../../src/template/face-template';
 
 const MODELS = resolve(import.meta.dirname, '../..', process.env.MODELS_DIR ?? 'models');
+const ROOT = resolve(import.meta.dirname, '../..');
 const buf = (p: string) => {
   const b = readFileSync(resolve(MODELS, p));
   return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer;
@@ -111,18 +114,29 @@ describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
     expect(maxAbsDiff(y, f32(fx, 'vertices').subarray(0, y.length))).toBeLessThan(1e-3); // mm: 1e-4 of the template's cm
   });
 
-  it('the fast CPU decoder matches PyTorch and the reference decoder', async () => {
+  it.each(['js', 'wasm-simd'] as const)('the fast CPU decoder (%s arithmetic) matches PyTorch and the reference decoder', async (kernel) => {
     const m = manifest.model.config;
     const template = await decodeTemplate(JSON.parse(readFileSync(resolve(MODELS, manifest.template.path), 'utf8')), buf(manifest.template.path.replace('.json', '.bin')));
     const weights = decoderWeights(parseSafetensors(buf(manifest.files.decoder_weights)).tensors, m);
     const frames = manifest.fixtures.token_frames;
     const tokens = f32(fx, 'tokens'), poseTok = f32(fx, 'pose_token');
-    const fast = new FastDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
+    const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
+    expect(decoder.kernelName).toBe(kernel);
+    const fast = decoder.decode(tokens, poseTok, frames);
     const ref = new ReferenceDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
     expect(maxAbsDiff(fast.offsets, f32(fx, 'offsets').subarray(0, fast.offsets.length))).toBeLessThan(1e-4);
     expect(maxAbsDiff(fast.pose, f32(fx, 'pose').subarray(0, fast.pose.length))).toBeLessThan(1e-5);
     expect(maxAbsDiff(fast.offsets, ref.offsets)).toBeLessThan(1e-4);
     expect(maxAbsDiff(fast.pose, ref.pose)).toBeLessThan(1e-5);
+    // Decoding again reuses the buffers: the same numbers.
+    expect(maxAbsDiff(decoder.decode(tokens, poseTok, frames).offsets, fast.offsets)).toBe(0);
+  });
+
+  it('the engine\'s default CPU decoder here is the SIMD one', async () => {
+    const m = manifest.model.config;
+    const template = await decodeTemplate(JSON.parse(readFileSync(resolve(MODELS, manifest.template.path), 'utf8')), buf(manifest.template.path.replace('.json', '.bin')));
+    const weights = decoderWeights(parseSafetensors(buf(manifest.files.decoder_weights)).tensors, m);
+    expect(new FastDecoder(weights, template.adjacency, m).kernelName).toBe('wasm-simd');
   });
 });
 
@@ -166,6 +180,66 @@ describe('the fast decoder\'s kernels', () => {
           for (let i = 0; i < cols; i++) s += W[o * cols + i] * X[t * cols + i];
           expect(out[t * outs + o]).toBeCloseTo(s, 5);
         }
+    }
+  });
+
+  it('the SIMD kernel\'s operations equal the TypeScript kernel\'s, for every remainder', () => {
+    const simd = new SimdKernel(1 << 20);
+    const wave = (n: number, f: number, a = 1) => Float32Array.from({ length: n }, (_, i) => a * Math.sin(i * f + 0.3));
+    // Matrix products: outputs in 16s and 4s (and not a multiple of 4: the TypeScript product), odd column counts.
+    for (const [rows, outs, cols] of [[2, 4, 1], [2, 16, 5], [4, 20, 7], [6, 36, 32], [2, 6, 8], [470, 96, 32]]) {
+      const W = wave(outs * cols, 1.3), b = wave(outs, 0.9);
+      const X = wave(rows * cols, 0.7);
+      const want = new Float32Array(rows * outs);
+      jsKernel.matmul(jsKernel.pack(W, b, outs, cols), X, rows, want);
+      const got = simd.alloc(rows * outs);
+      simd.matmul(simd.pack(W, b, outs, cols), simd.place(X), rows, got);
+      expect(maxAbsDiff(got, want)).toBeLessThan(1e-5 * cols);
+    }
+    expect(() => simd.matmul(simd.pack(wave(16, 1), wave(4, 1), 4, 4), simd.alloc(12), 3, simd.alloc(12))).toThrow(/even/);
+    expect(() => simd.matmul(simd.pack(wave(16, 1), wave(4, 1), 4, 4), new Float32Array(8), 2, simd.alloc(8))).toThrow(/not allocated/);
+    // LayerNorm and GELU are float64 in both: the same bits.
+    for (const d of [4, 7, 32]) {
+      const X = wave(5 * d, 0.41, 3), g = wave(d, 0.2), bb = wave(d, 0.5);
+      const want = new Float32Array(5 * d);
+      jsKernel.layerNorm(X, 5, d, g, bb, want);
+      const got = simd.alloc(5 * d);
+      simd.layerNorm(simd.place(X), 5, d, simd.place(g), simd.place(bb), got);
+      expect(maxAbsDiff(got, want)).toBe(0);
+    }
+    const xs = Float32Array.from({ length: 20001 }, (_, i) => -10 + i / 1000);
+    const want = xs.slice();
+    jsKernel.gelu(want, want.length - 1); // the last element untouched in both
+    const got = simd.place(xs);
+    simd.gelu(got, got.length - 1);
+    expect(maxAbsDiff(got, want)).toBe(0);
+    // Residual sums, with a remainder after the vectors.
+    const x = wave(23, 0.3), y = wave(23, 0.8);
+    const sx = simd.place(x);
+    simd.add(sx, simd.place(y), 23);
+    jsKernel.add(x, y, 23);
+    expect(maxAbsDiff(sx, x)).toBe(0);
+  });
+
+  it('the SIMD attention equals the TypeScript attention on ragged key lists, large and small scores', () => {
+    const simd = new SimdKernel(1 << 20);
+    for (const [d, heads, amp] of [[32, 4, 1], [16, 1, 1], [32, 2, 40]]) {
+      const tokens = 9;
+      const keyStart = Int32Array.from([0, 1, 3, 6, 6 + 9, 16, 18, 20, 23, 24]); // one token sees all 9
+      const keys = Int32Array.from([0, 1, 0, 2, 5, 8, 0, 1, 2, 3, 4, 5, 6, 7, 8, 4, 5, 3, 6, 2, 7, 1, 4, 8]);
+      const qkv = Float32Array.from({ length: tokens * 3 * d }, (_, i) => amp * Math.sin(i * 0.37));
+      const want = new Float32Array(tokens * d);
+      jsKernel.attention(qkv, tokens, d, heads, keyStart, keys, new Float64Array(tokens), want);
+      const got = simd.alloc(tokens * d);
+      simd.attention(simd.place(qkv), tokens, d, heads, simd.placeInts(keyStart), simd.placeInts(keys), simd.scratch(tokens), got);
+      expect(maxAbsDiff(got, want)).toBeLessThan(1e-5 * amp);
+    }
+  });
+
+  it('the embedded WebAssembly is what the committed .wat assembles to (npm run build:wasm)', async () => {
+    for (const k of KERNELS) {
+      const bytes = await assemble(k.wat);
+      expect(readFileSync(resolve(ROOT, k.out), 'utf8')).toBe(generatedSource(k.wat, bytes));
     }
   });
 

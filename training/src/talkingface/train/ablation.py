@@ -118,7 +118,8 @@ def main(argv=None) -> int:
     ap.add_argument("--frames", default="8")
     ap.add_argument("--jobs", type=int, default=1, help="trainings run side by side (each gets cores / jobs threads)")
     args = ap.parse_args(argv)
-    extra = ["--batch-clips", args.batch_clips, "--frames", args.frames]
+    # The rows train on the dataset's clips alone (no silence crops), as the paper's ablation does.
+    extra = ["--batch-clips", args.batch_clips, "--frames", args.frames, "--silence", "0"]
     results = {row: [] for row in args.rows}
     batch = f"{args.batch_clips} clips x {args.frames} frames"
     t0 = time.time()

@@ -3,6 +3,15 @@
 A clip is loaded once: log-Mel of the whole waveform, per-frame ground truth in mm, the phone
 label of every content frame. A crop of T animation frames takes its Mel from 1 s before the
 first frame (the pose LSTM warms up on it) to just past the look-ahead after the last.
+
+Silence crops (`silence` > 0): a dataset's clips hold only short pauses, where the face is still
+moving into or out of speech (in our corpus the inner lips are 2.0 mm apart on average in frames
+labelled silence), so a model trained on them alone never learns what a long silence looks like
+and leaves the mouth ajar when a microphone hears nothing. A silence crop is a stretch (warm-up and
+crop, over a second) of digital silence or faint noise (-90 to -50 dBFS) whose target is the subject's rest face: the
+frame of its clips, among those labelled silence with the eyes open, where the inner lips are
+closest, with the head in its neutral pose. Nothing here assumes our corpus: unlabelled data
+counts every frame as silence, and the rest face is then the subject's most closed-mouth frame.
 """
 from __future__ import annotations
 
@@ -12,9 +21,11 @@ import numpy as np
 import torch
 
 from ..corpus.phonemes import PHONE_INDEX, SILENCE
+from ..corpus.checks import contour_gap
 from ..data.datasets import FaceDataset
 from ..features import AudioConfig, frame_to_mel_index, log_mel
 from ..model.config import ModelConfig
+from ..template import Template
 
 WARMUP_SECONDS = 1.0
 
@@ -28,6 +39,7 @@ class PreparedClip:
     template: np.ndarray        # (N, 3) mm
     pose: np.ndarray            # (F, 6) axis-angle (rad), translation (mm)
     source: str                 # "tts" or "human" (recorded speech)
+    rest: np.ndarray | None = None  # (N, 3) the subject's rest face, mm (set by attach_rest_faces)
 
     @property
     def num_frames(self) -> int:
@@ -64,8 +76,53 @@ class Batch:
     pose: torch.Tensor        # (B, T, 6)
 
 
+def attach_rest_faces(clips: list[PreparedClip], template: Template) -> dict[str, float]:
+    """Give every clip its subject's rest face (subjects told apart by their neutral template).
+    -> per subject, the rest face's inner-lip gap in mm (for the training log)."""
+    r = template.regions
+    up, lo = r["lips_inner_upper"], r["lips_inner_lower"]
+    eyes = [(r[f"eye_{s}_upper"], r[f"eye_{s}_lower"]) for s in ("left", "right")]
+    silence = PHONE_INDEX[SILENCE]
+    groups: dict[bytes, list[PreparedClip]] = {}
+    for c in clips:
+        groups.setdefault(c.template.tobytes(), []).append(c)
+    gaps = {}
+    for n, group in enumerate(groups.values()):
+        cand = []
+        for c in group:
+            mi = np.clip(frame_to_mel_index(np.arange(c.num_frames)), 0, len(c.phones) - 1)
+            quiet = np.flatnonzero(c.phones[mi] == silence)
+            if len(quiet):
+                v = c.vertices[quiet]
+                eye = np.minimum(*[contour_gap(v, u, l) for u, l in eyes])
+                cand.append((v, contour_gap(v, up, lo), eye))
+        if not cand:  # no frame labelled silence: every frame is a candidate
+            cand = [(c.vertices, contour_gap(c.vertices, up, lo), np.minimum(*[contour_gap(c.vertices, u, l) for u, l in eyes]))
+                    for c in group]
+        v = np.concatenate([x[0] for x in cand])
+        lip = np.concatenate([x[1] for x in cand])
+        eye = np.concatenate([x[2] for x in cand])
+        open_eyes = eye >= 0.9 * eye.max()
+        best = np.flatnonzero(open_eyes)[np.argmin(lip[open_eyes])]
+        for c in group:
+            c.rest = v[best].copy()
+        gaps[f"subject {n}"] = float(lip[best])
+    return gaps
+
+
+def silence_mel(seconds: float, rng: np.random.Generator, audio: AudioConfig) -> np.ndarray:
+    """Log-Mel of `seconds` of digital silence (a third of the time) or faint white noise, -90 to -50 dBFS."""
+    n = int(seconds * audio.sample_rate)
+    if rng.random() < 1 / 3:
+        wav = np.zeros(n, np.float32)
+    else:
+        wav = (rng.standard_normal(n) * 10 ** (rng.uniform(-90, -50) / 20)).astype(np.float32)
+    return log_mel(wav, audio)
+
+
 def sample_batch(clips: list[PreparedClip], rng: np.random.Generator, n_clips: int, frames: int,
-                 model_cfg: ModelConfig, audio: AudioConfig = AudioConfig()) -> Batch:
+                 model_cfg: ModelConfig, audio: AudioConfig = AudioConfig(), silence: float = 0.0) -> Batch:
+    """`silence`: the chance that a crop is a silence crop (module docstring); needs attach_rest_faces."""
     warm = int(WARMUP_SECONDS * audio.feature_rate)
     # Past the last frame: the content window's future frames plus the convolutions' reach.
     ahead = model_cfg.content_stride * (model_cfg.window_future + 4) + 4
@@ -73,6 +130,21 @@ def sample_batch(clips: list[PreparedClip], rng: np.random.Generator, n_clips: i
     items = []
     for i in picks:
         c = clips[i]
+        if silence > 0 and rng.random() < silence:
+            if c.rest is None:
+                raise ValueError("silence crops need the rest faces: call attach_rest_faces first")
+            f0 = int(np.ceil(WARMUP_SECONDS * audio.fps))
+            fr = np.arange(f0, f0 + frames)
+            mi = frame_to_mel_index(fr, audio)
+            k0 = max(0, mi[0] - warm)
+            k0 -= k0 % model_cfg.content_stride
+            mel = silence_mel((mi[-1] + ahead + 2) * audio.hop / audio.sample_rate, rng, audio)
+            k1 = min(len(mel), mi[-1] + ahead)
+            rest = np.broadcast_to(c.rest, (frames, *c.rest.shape))
+            quiet = PreparedClip(c.key + ":silence", mel, np.full(len(mel), PHONE_INDEX[SILENCE], np.int64),
+                                 rest, c.template, np.zeros((frames, 6), np.float32), "silence", c.rest)
+            items.append((quiet, np.arange(frames), mi - k0, k0, k1))
+            continue
         T = min(frames, c.num_frames)
         f0 = int(rng.integers(0, c.num_frames - T + 1))
         fr = np.arange(f0, f0 + T)

@@ -26,7 +26,7 @@ from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
-from .data import mel_statistics, prepare, sample_batch
+from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
 from .losses import LossWeights, total_loss
 from .metrics import eye_region, lip_region
 
@@ -66,6 +66,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--checkpoint-every", type=int, default=200)
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
     ap.add_argument("--paper-loss", action="store_true", help="the paper's Eq. 3 exactly (no unposed or lip reconstruction terms; see losses.py)")
+    ap.add_argument("--silence", type=float, default=0.1,
+                    help="chance that a crop is pure silence with the rest face as target (data.py); 0 = the paper's data")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -93,6 +95,11 @@ def main(argv=None) -> int:
     clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
         f"prepared in {time.time() - t0:.0f} s; {world} process(es)")
+
+    if args.silence > 0:
+        gaps = attach_rest_faces(clips, ds.template)
+        log(f"silence crops: {args.silence:.0%} of crops; rest faces' inner-lip gap {min(gaps.values()):.2f}-{max(gaps.values()):.2f} mm "
+            f"({len(gaps)} subjects)")
 
     torch.manual_seed(args.seed)
     model = TalkingFace(cfg, ds.template, audio)
@@ -148,7 +155,7 @@ def main(argv=None) -> int:
         progress = step / budget_steps if budget_steps else trained_seconds / (60 * args.minutes)
         for g in opt.param_groups:
             g["lr"] = args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
-        b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio)
+        b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
         out_ = net(b.mel, b.mel_index, b.template)
         loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights)
         opt.zero_grad(set_to_none=True)

@@ -1,0 +1,326 @@
+;; The CPU decoder's layers in WebAssembly: matrix products, attention and residual sums in SIMD
+;; (four float lanes), LayerNorm and GELU in float64 exactly as fast-decoder.ts computes them.
+;;
+;; Assembled by `npm run build:wasm` (scripts/build-wasm.ts) into decoder-wasm.ts, which embeds the
+;; bytes; a unit test assembles this file again and checks the embedded bytes are what it gives.
+;; decoder-kernels.ts (SimdKernel) drives it; its TypeScript twin is jsKernel in the same file.
+;;
+;; All pointers are byte addresses in the exported memory, all values float32.
+(module
+  (memory (export "memory") 1)
+
+  ;; out[t, o] = b[o] + sum_i wt[i, o] * x[t, i]   for t < rows, o < outs
+  ;; wt: cols x outs (the weight matrix transposed, so four consecutive outputs are one vector load),
+  ;; x: rows x cols, out: rows x outs, row-major. Needs rows even (callers pad the token count) and
+  ;; outs a multiple of 4. Two tokens at a time share every weight load; outputs go 16 at a time
+  ;; (eight accumulators), then 4 at a time for what is left.
+  (func (export "matmul")
+    (param $wt i32) (param $b i32) (param $outs i32) (param $cols i32)
+    (param $x i32) (param $rows i32) (param $out i32)
+    (local $t i32) (local $o i32) (local $i i32) (local $stride i32) (local $xrow i32)
+    (local $xp0 i32) (local $xp1 i32) (local $wp i32) (local $op0 i32) (local $op1 i32)
+    (local $p v128) (local $q v128) (local $w v128)
+    (local $a0 v128) (local $a1 v128) (local $a2 v128) (local $a3 v128)
+    (local $c0 v128) (local $c1 v128) (local $c2 v128) (local $c3 v128)
+    (local.set $stride (i32.shl (local.get $outs) (i32.const 2)))
+    (local.set $xrow (i32.shl (local.get $cols) (i32.const 2)))
+    (local.set $t (i32.const 0))
+    (block $rows_done
+      (loop $rows_loop
+        (br_if $rows_done (i32.ge_u (local.get $t) (local.get $rows)))
+        (local.set $xp0 (i32.add (local.get $x) (i32.mul (local.get $t) (local.get $xrow))))
+        (local.set $xp1 (i32.add (local.get $xp0) (local.get $xrow)))
+        (local.set $op0 (i32.add (local.get $out) (i32.mul (local.get $t) (local.get $stride))))
+        (local.set $op1 (i32.add (local.get $op0) (local.get $stride)))
+        (local.set $o (i32.const 0))
+        ;; sixteen outputs at a time
+        (block $wide_done
+          (loop $wide_loop
+            (br_if $wide_done (i32.gt_u (i32.add (local.get $o) (i32.const 16)) (local.get $outs)))
+            (local.set $wp (i32.add (local.get $b) (i32.shl (local.get $o) (i32.const 2))))
+            (local.set $a0 (v128.load offset=0 (local.get $wp)))
+            (local.set $a1 (v128.load offset=16 (local.get $wp)))
+            (local.set $a2 (v128.load offset=32 (local.get $wp)))
+            (local.set $a3 (v128.load offset=48 (local.get $wp)))
+            (local.set $c0 (local.get $a0))
+            (local.set $c1 (local.get $a1))
+            (local.set $c2 (local.get $a2))
+            (local.set $c3 (local.get $a3))
+            (local.set $wp (i32.add (local.get $wt) (i32.shl (local.get $o) (i32.const 2))))
+            (local.set $i (i32.const 0))
+            (loop $k_loop
+              (local.set $p (f32x4.splat (f32.load (i32.add (local.get $xp0) (local.get $i)))))
+              (local.set $q (f32x4.splat (f32.load (i32.add (local.get $xp1) (local.get $i)))))
+              (local.set $w (v128.load offset=0 (local.get $wp)))
+              (local.set $a0 (f32x4.add (local.get $a0) (f32x4.mul (local.get $w) (local.get $p))))
+              (local.set $c0 (f32x4.add (local.get $c0) (f32x4.mul (local.get $w) (local.get $q))))
+              (local.set $w (v128.load offset=16 (local.get $wp)))
+              (local.set $a1 (f32x4.add (local.get $a1) (f32x4.mul (local.get $w) (local.get $p))))
+              (local.set $c1 (f32x4.add (local.get $c1) (f32x4.mul (local.get $w) (local.get $q))))
+              (local.set $w (v128.load offset=32 (local.get $wp)))
+              (local.set $a2 (f32x4.add (local.get $a2) (f32x4.mul (local.get $w) (local.get $p))))
+              (local.set $c2 (f32x4.add (local.get $c2) (f32x4.mul (local.get $w) (local.get $q))))
+              (local.set $w (v128.load offset=48 (local.get $wp)))
+              (local.set $a3 (f32x4.add (local.get $a3) (f32x4.mul (local.get $w) (local.get $p))))
+              (local.set $c3 (f32x4.add (local.get $c3) (f32x4.mul (local.get $w) (local.get $q))))
+              (local.set $wp (i32.add (local.get $wp) (local.get $stride)))
+              (local.set $i (i32.add (local.get $i) (i32.const 4)))
+              (br_if $k_loop (i32.lt_u (local.get $i) (local.get $xrow))))
+            (local.set $wp (i32.add (local.get $op0) (i32.shl (local.get $o) (i32.const 2))))
+            (v128.store offset=0 (local.get $wp) (local.get $a0))
+            (v128.store offset=16 (local.get $wp) (local.get $a1))
+            (v128.store offset=32 (local.get $wp) (local.get $a2))
+            (v128.store offset=48 (local.get $wp) (local.get $a3))
+            (local.set $wp (i32.add (local.get $op1) (i32.shl (local.get $o) (i32.const 2))))
+            (v128.store offset=0 (local.get $wp) (local.get $c0))
+            (v128.store offset=16 (local.get $wp) (local.get $c1))
+            (v128.store offset=32 (local.get $wp) (local.get $c2))
+            (v128.store offset=48 (local.get $wp) (local.get $c3))
+            (local.set $o (i32.add (local.get $o) (i32.const 16)))
+            (br $wide_loop)))
+        ;; four outputs at a time
+        (block $narrow_done
+          (loop $narrow_loop
+            (br_if $narrow_done (i32.ge_u (local.get $o) (local.get $outs)))
+            (local.set $a0 (v128.load (i32.add (local.get $b) (i32.shl (local.get $o) (i32.const 2)))))
+            (local.set $c0 (local.get $a0))
+            (local.set $wp (i32.add (local.get $wt) (i32.shl (local.get $o) (i32.const 2))))
+            (local.set $i (i32.const 0))
+            (loop $k_loop4
+              (local.set $w (v128.load (local.get $wp)))
+              (local.set $a0 (f32x4.add (local.get $a0)
+                (f32x4.mul (local.get $w) (f32x4.splat (f32.load (i32.add (local.get $xp0) (local.get $i)))))))
+              (local.set $c0 (f32x4.add (local.get $c0)
+                (f32x4.mul (local.get $w) (f32x4.splat (f32.load (i32.add (local.get $xp1) (local.get $i)))))))
+              (local.set $wp (i32.add (local.get $wp) (local.get $stride)))
+              (local.set $i (i32.add (local.get $i) (i32.const 4)))
+              (br_if $k_loop4 (i32.lt_u (local.get $i) (local.get $xrow))))
+            (v128.store (i32.add (local.get $op0) (i32.shl (local.get $o) (i32.const 2))) (local.get $a0))
+            (v128.store (i32.add (local.get $op1) (i32.shl (local.get $o) (i32.const 2))) (local.get $c0))
+            (local.set $o (i32.add (local.get $o) (i32.const 4)))
+            (br $narrow_loop)))
+        (local.set $t (i32.add (local.get $t) (i32.const 2)))
+        (br $rows_loop))))
+;; x[i] += y[i] for i < count
+  (func (export "add") (param $x i32) (param $y i32) (param $count i32)
+    (local $end i32) (local $end4 i32)
+    (local.set $end (i32.add (local.get $x) (i32.shl (local.get $count) (i32.const 2))))
+    (local.set $end4 (i32.add (local.get $x) (i32.shl (i32.and (local.get $count) (i32.const -4)) (i32.const 2))))
+    (block $done
+      (loop $vec
+        (br_if $done (i32.ge_u (local.get $x) (local.get $end4)))
+        (v128.store (local.get $x) (f32x4.add (v128.load (local.get $x)) (v128.load (local.get $y))))
+        (local.set $x (i32.add (local.get $x) (i32.const 16)))
+        (local.set $y (i32.add (local.get $y) (i32.const 16)))
+        (br $vec)))
+    (block $done1
+      (loop $one
+        (br_if $done1 (i32.ge_u (local.get $x) (local.get $end)))
+        (f32.store (local.get $x) (f32.add (f32.load (local.get $x)) (f32.load (local.get $y))))
+        (local.set $x (i32.add (local.get $x) (i32.const 4)))
+        (local.set $y (i32.add (local.get $y) (i32.const 4)))
+        (br $one))))
+
+  ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps 1e-5)
+  (func (export "layer_norm") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+    (local $t i32) (local $i i32) (local $row i32) (local $mean f64) (local $var f64) (local $c f64) (local $inv f64)
+    (local $db i32)
+    (local.set $db (i32.shl (local.get $d) (i32.const 2)))
+    (block $rows_done
+      (loop $rows_loop
+        (br_if $rows_done (i32.ge_u (local.get $t) (local.get $rows)))
+        (local.set $row (i32.mul (local.get $t) (local.get $db)))
+        (local.set $mean (f64.const 0))
+        (local.set $i (i32.const 0))
+        (loop $sum
+          (local.set $mean (f64.add (local.get $mean)
+            (f64.promote_f32 (f32.load (i32.add (local.get $x) (i32.add (local.get $row) (local.get $i)))))))
+          (local.set $i (i32.add (local.get $i) (i32.const 4)))
+          (br_if $sum (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $mean (f64.div (local.get $mean) (f64.convert_i32_u (local.get $d))))
+        (local.set $var (f64.const 0))
+        (local.set $i (i32.const 0))
+        (loop $sq
+          (local.set $c (f64.sub
+            (f64.promote_f32 (f32.load (i32.add (local.get $x) (i32.add (local.get $row) (local.get $i)))))
+            (local.get $mean)))
+          (local.set $var (f64.add (local.get $var) (f64.mul (local.get $c) (local.get $c))))
+          (local.set $i (i32.add (local.get $i) (i32.const 4)))
+          (br_if $sq (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $inv (f64.div (f64.const 1)
+          (f64.sqrt (f64.add (f64.div (local.get $var) (f64.convert_i32_u (local.get $d))) (f64.const 1e-5)))))
+        (local.set $i (i32.const 0))
+        (loop $norm
+          (f32.store (i32.add (local.get $out) (i32.add (local.get $row) (local.get $i)))
+            (f32.demote_f64 (f64.add
+              (f64.mul
+                (f64.mul
+                  (f64.sub (f64.promote_f32 (f32.load (i32.add (local.get $x) (i32.add (local.get $row) (local.get $i)))))
+                           (local.get $mean))
+                  (local.get $inv))
+                (f64.promote_f32 (f32.load (i32.add (local.get $g) (local.get $i)))))
+              (f64.promote_f32 (f32.load (i32.add (local.get $b) (local.get $i)))))))
+          (local.set $i (i32.add (local.get $i) (i32.const 4)))
+          (br_if $norm (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $t (i32.add (local.get $t) (i32.const 1)))
+        (br $rows_loop))))
+
+  ;; GELU in place over a[0..count): the exact function tabulated (value, slope: float64, `steps` points
+  ;; per unit on [-range, range]) with cubic Hermite interpolation, as fast-decoder.ts's geluInPlace.
+  (func (export "gelu") (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
+    (local $end i32) (local $x f64) (local $u f64) (local $k f64) (local $s f64) (local $s2 f64) (local $s3 f64) (local $o i32)
+    (local.set $end (i32.add (local.get $a) (i32.shl (local.get $count) (i32.const 2))))
+    (block $done
+      (loop $each
+        (br_if $done (i32.ge_u (local.get $a) (local.get $end)))
+        (local.set $x (f64.promote_f32 (f32.load (local.get $a))))
+        (if (f64.lt (local.get $x) (local.get $range))
+          (then
+            (if (f64.le (local.get $x) (f64.neg (local.get $range)))
+              (then (f32.store (local.get $a) (f32.const 0)))
+              (else
+                (local.set $u (f64.mul (f64.add (local.get $x) (local.get $range)) (local.get $steps)))
+                (local.set $k (f64.floor (local.get $u)))
+                (local.set $s (f64.sub (local.get $u) (local.get $k)))
+                (local.set $s2 (f64.mul (local.get $s) (local.get $s)))
+                (local.set $s3 (f64.mul (local.get $s2) (local.get $s)))
+                (local.set $o (i32.shl (i32.trunc_f64_s (local.get $k)) (i32.const 3)))
+                (f32.store (local.get $a) (f32.demote_f64
+                  (f64.add
+                    (f64.add
+                      (f64.add
+                        (f64.mul
+                          (f64.add (f64.sub (f64.mul (f64.const 2) (local.get $s3)) (f64.mul (f64.const 3) (local.get $s2))) (f64.const 1))
+                          (f64.load (i32.add (local.get $value) (local.get $o))))
+                        (f64.mul
+                          (f64.add (f64.sub (local.get $s3) (f64.mul (f64.const 2) (local.get $s2))) (local.get $s))
+                          (f64.load (i32.add (local.get $slope) (local.get $o)))))
+                      (f64.mul
+                        (f64.sub (f64.mul (f64.const 3) (local.get $s2)) (f64.mul (f64.const 2) (local.get $s3)))
+                        (f64.load offset=8 (i32.add (local.get $value) (local.get $o)))))
+                    (f64.mul
+                      (f64.sub (local.get $s3) (local.get $s2))
+                      (f64.load offset=8 (i32.add (local.get $slope) (local.get $o)))))))))))
+        (local.set $a (i32.add (local.get $a) (i32.const 4)))
+        (br $each))))
+
+  ;; e^x for x <= 0 (softmax weights), float64: x = k ln 2 + r, |r| <= ln 2 / 2, a degree-8 Taylor
+  ;; polynomial for e^r (relative error < 1e-8), times 2^k built from the exponent bits.
+  (func $exp (param $x f64) (result f64)
+    (local $k f64) (local $r f64)
+    (if (f64.lt (local.get $x) (f64.const -700)) (then (local.set $x (f64.const -700))))
+    (local.set $k (f64.nearest (f64.mul (local.get $x) (f64.const 1.4426950408889634))))
+    (local.set $r (f64.sub (f64.sub (local.get $x) (f64.mul (local.get $k) (f64.const 0.6931471803691238)))
+                           (f64.mul (local.get $k) (f64.const 1.9082149292705877e-10))))
+    (f64.mul
+      (f64.add (f64.const 1) (f64.mul (local.get $r)
+      (f64.add (f64.const 1) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.5) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.16666666666666666) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.041666666666666664) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.008333333333333333) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.001388888888888889) (f64.mul (local.get $r)
+      (f64.add (f64.const 0.0001984126984126984) (f64.mul (local.get $r)
+        (f64.const 0.0000248015873015873)))))))))))))))))
+      (f64.reinterpret_i64 (i64.shl (i64.add (i64.trunc_f64_s (local.get $k)) (i64.const 1023)) (i64.const 52)))))
+  (export "exp" (func $exp))
+
+  ;; Neighbour-masked multi-head attention over `tokens` tokens: qkv rows (tokens x 3d: queries, keys,
+  ;; values), token t attends to keys key_index[key_start[t] .. key_start[t + 1]) (int32), softmax of
+  ;; q.k * scale per head, weights times values into out (tokens x d). `scores` is float64 scratch
+  ;; for the longest key list. Head size d / heads must be a multiple of 4.
+  (func (export "attention")
+    (param $qkv i32) (param $tokens i32) (param $d i32) (param $heads i32)
+    (param $key_start i32) (param $key_index i32) (param $scores i32) (param $out i32) (param $scale f64)
+    (local $t i32) (local $hd i32) (local $s i32) (local $k0 i32) (local $k1 i32) (local $i i32)
+    (local $row3 i32) (local $db i32) (local $dkb i32) (local $qo i32) (local $ko i32) (local $ao i32) (local $sp i32)
+    (local $acc v128) (local $w v128) (local $dot f64) (local $max f64) (local $sum f64) (local $e f64) (local $inv f64)
+    (local.set $db (i32.shl (local.get $d) (i32.const 2)))
+    (local.set $row3 (i32.mul (local.get $db) (i32.const 3)))
+    (local.set $dkb (i32.div_u (local.get $db) (local.get $heads)))
+    (block $tokens_done
+      (loop $tokens_loop
+        (br_if $tokens_done (i32.ge_u (local.get $t) (local.get $tokens)))
+        (local.set $k0 (i32.load (i32.add (local.get $key_start) (i32.shl (local.get $t) (i32.const 2)))))
+        (local.set $k1 (i32.load offset=4 (i32.add (local.get $key_start) (i32.shl (local.get $t) (i32.const 2)))))
+        (local.set $hd (i32.const 0))
+        (loop $heads_loop
+          (local.set $qo (i32.add (local.get $qkv)
+            (i32.add (i32.mul (local.get $t) (local.get $row3)) (i32.mul (local.get $hd) (local.get $dkb)))))
+          ;; scores and their maximum
+          (local.set $max (f64.const -inf))
+          (local.set $s (local.get $k0))
+          (local.set $sp (local.get $scores))
+          (block $scored
+            (loop $score_loop
+              (br_if $scored (i32.ge_u (local.get $s) (local.get $k1)))
+              (local.set $ko (i32.add (local.get $qkv)
+                (i32.add (i32.add (i32.mul (i32.load (i32.add (local.get $key_index) (i32.shl (local.get $s) (i32.const 2))))
+                                           (local.get $row3))
+                                  (local.get $db))
+                         (i32.mul (local.get $hd) (local.get $dkb)))))
+              (local.set $acc (f32x4.mul (v128.load (local.get $qo)) (v128.load (local.get $ko))))
+              (local.set $i (i32.const 16))
+              (block $dot_done
+                (loop $dot_loop
+                  (br_if $dot_done (i32.ge_u (local.get $i) (local.get $dkb)))
+                  (local.set $acc (f32x4.add (local.get $acc)
+                    (f32x4.mul (v128.load (i32.add (local.get $qo) (local.get $i))) (v128.load (i32.add (local.get $ko) (local.get $i))))))
+                  (local.set $i (i32.add (local.get $i) (i32.const 16)))
+                  (br $dot_loop)))
+              (local.set $dot (f64.mul (local.get $scale) (f64.promote_f32
+                (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
+                         (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc)))))))
+              (f64.store (local.get $sp) (local.get $dot))
+              (if (f64.gt (local.get $dot) (local.get $max)) (then (local.set $max (local.get $dot))))
+              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
+              (local.set $s (i32.add (local.get $s) (i32.const 1)))
+              (br $score_loop)))
+          ;; softmax
+          (local.set $sum (f64.const 0))
+          (local.set $sp (local.get $scores))
+          (local.set $s (local.get $k0))
+          (block $exped
+            (loop $exp_loop
+              (br_if $exped (i32.ge_u (local.get $s) (local.get $k1)))
+              (local.set $e (call $exp (f64.sub (f64.load (local.get $sp)) (local.get $max))))
+              (f64.store (local.get $sp) (local.get $e))
+              (local.set $sum (f64.add (local.get $sum) (local.get $e)))
+              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
+              (local.set $s (i32.add (local.get $s) (i32.const 1)))
+              (br $exp_loop)))
+          (local.set $inv (f64.div (f64.const 1) (local.get $sum)))
+          ;; weighted sum of the values
+          (local.set $ao (i32.add (local.get $out)
+            (i32.add (i32.mul (local.get $t) (local.get $db)) (i32.mul (local.get $hd) (local.get $dkb)))))
+          (local.set $i (i32.const 0))
+          (loop $zero
+            (v128.store (i32.add (local.get $ao) (local.get $i)) (v128.const f32x4 0 0 0 0))
+            (local.set $i (i32.add (local.get $i) (i32.const 16)))
+            (br_if $zero (i32.lt_u (local.get $i) (local.get $dkb))))
+          (local.set $sp (local.get $scores))
+          (local.set $s (local.get $k0))
+          (block $summed
+            (loop $value_loop
+              (br_if $summed (i32.ge_u (local.get $s) (local.get $k1)))
+              (local.set $w (f32x4.splat (f32.demote_f64 (f64.mul (f64.load (local.get $sp)) (local.get $inv)))))
+              (local.set $ko (i32.add (local.get $qkv)
+                (i32.add (i32.add (i32.mul (i32.load (i32.add (local.get $key_index) (i32.shl (local.get $s) (i32.const 2))))
+                                           (local.get $row3))
+                                  (i32.shl (local.get $db) (i32.const 1)))
+                         (i32.mul (local.get $hd) (local.get $dkb)))))
+              (local.set $i (i32.const 0))
+              (loop $acc_loop
+                (v128.store (i32.add (local.get $ao) (local.get $i))
+                  (f32x4.add (v128.load (i32.add (local.get $ao) (local.get $i)))
+                             (f32x4.mul (local.get $w) (v128.load (i32.add (local.get $ko) (local.get $i))))))
+                (local.set $i (i32.add (local.get $i) (i32.const 16)))
+                (br_if $acc_loop (i32.lt_u (local.get $i) (local.get $dkb))))
+              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
+              (local.set $s (i32.add (local.get $s) (i32.const 1)))
+              (br $value_loop)))
+          (local.set $hd (i32.add (local.get $hd) (i32.const 1)))
+          (br_if $heads_loop (i32.lt_u (local.get $hd) (local.get $heads))))
+        (local.set $t (i32.add (local.get $t) (i32.const 1)))
+        (br $tokens_loop))))
+)
