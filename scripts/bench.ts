@@ -119,13 +119,14 @@ function print(r: Record<string, unknown>): void {
     console.log(`${name.padEnd(14)} ${f(v.wall_ms, 0).padStart(9)}   ${f(v.rtf, 2).padStart(17)}   ${f(v.first_frame_ms, 0).padStart(16)}   ${f(v.peak_heap_bytes / 1e6).padStart(14)}   ` +
       [s.mel, s.content, s.hierarchical, s.pose, s.decoder, s.posing].map((x) => f(x, 0)).join(' / '));
   }
-  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms`);
+  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
+    `CPU decoder: ${r.cpu_decoder_kernel} on ${r.cpu_decoder_threads} thread(s)`);
   console.log(`streaming latency (sample in -> frame out) p50 ${f(r.stream_latency_ms as number, 0)} ms, p95 ${f(r.stream_latency_p95_ms as number, 0)} ms; ` +
     `of which look-ahead ${f(r.stream_look_ahead_ms as number, 0)} ms, pieces of ${f(r.stream_piece_ms as number, 0)} ms`);
   console.log('decoder time per frame by vertex count:', JSON.stringify(r.attention_by_vertices));
-  const nd = r.node as Record<string, number>;
+  const nd = r.node as Record<string, number> & { decoder_kernel: string };
   console.log(`Node: Mel ${f(nd.mel_ms_per_audio_second)} ms per audio second (Meyda.extract per frame: ${f(nd.mel_meyda_extract_ms_per_audio_second)}); ` +
-    `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame (reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
+    `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel} (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
   console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
 }
 

@@ -1,35 +1,66 @@
 /**
- * Export an animation as binary glTF (.glb) that standard viewers play: the neutral face as the mesh,
- * one morph target per frame (that frame's I + O minus I), a weights track that steps through the
- * frames, and the head pose as the node's rotation and translation. Also the raw per-frame vertices.
+ * Export an animation as binary glTF (.glb) that standard viewers play, with the head pose as the
+ * node's rotation and translation and the facial motion as morph targets, in one of two encodings:
+ * - up to GLB_EXACT_FRAMES frames, exact: the neutral face as the mesh, one morph target per frame
+ *   (that frame's I + O minus I) and a weights track that steps through them (one target on at a time);
+ * - longer clips, compact: the mean face as the mesh and GLB_COMPONENTS morph targets, the strongest
+ *   directions of the clip's motion (motion-basis.ts), with every frame's weights; the largest
+ *   deviation from the exact frames is measured and reported. Eight is the number of simultaneous
+ *   morph targets glTF asks every viewer to support, and the file grows by only 32 bytes a frame.
+ * Also the raw per-frame vertices.
  */
 import * as THREE from 'three';
 import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
+import { motionBasis } from './motion-basis';
 
-/** One morph target per frame makes the weights track frames x frames: cap the exported length. */
-export const GLB_MAX_FRAMES = 1800;
+/** Longest clip exported with one morph target per frame (its weights track is frames x frames). */
+export const GLB_EXACT_FRAMES = 1800;
+/** Morph targets in the compact encoding of longer clips. */
+export const GLB_COMPONENTS = 8;
 
 export interface GlbExport {
   bytes: ArrayBuffer;
   frames: number;
-  truncated: boolean;
+  encoding: 'per-frame' | 'components';
+  morphTargets: number;
+  /** Largest distance of any vertex from the exact animation, mm (0 for the per-frame encoding). */
+  maxErrorMm: number;
 }
 
 export async function exportGlb(animation: Animation, template: FaceTemplate, unitsPerMm: number, name = 'talking-face'): Promise<GlbExport> {
   if (!animation.unposed) throw new Error('exportGlb: the animation has no unposed frames');
-  const frames = Math.min(animation.frames, GLB_MAX_FRAMES);
+  const frames = animation.frames;
+  if (frames < 1) throw new Error('exportGlb: the animation has no frames');
   const n = template.vertexCount;
+  const dims = n * 3;
   const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(template.positions), 3));
-  geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
   const targets: THREE.BufferAttribute[] = [];
-  for (let f = 0; f < frames; f++) {
-    const d = new Float32Array(n * 3);
-    for (let i = 0; i < n * 3; i++) d[i] = animation.unposed[f * n * 3 + i] - template.positions[i];
-    targets.push(new THREE.BufferAttribute(d, 3));
+  let weights: Float32Array;
+  let maxErrorMm = 0;
+  const exact = frames <= GLB_EXACT_FRAMES;
+  if (exact) {
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(template.positions), 3));
+    for (let f = 0; f < frames; f++) {
+      const d = new Float32Array(dims);
+      for (let i = 0; i < dims; i++) d[i] = animation.unposed[f * dims + i] - template.positions[i];
+      targets.push(new THREE.BufferAttribute(d, 3));
+    }
+    weights = new Float32Array(frames * frames);
+    for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
+  } else {
+    const D = new Float32Array(frames * dims);
+    for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) D[f * dims + i] = animation.unposed[f * dims + i] - template.positions[i];
+    const m = motionBasis(D, frames, dims, GLB_COMPONENTS);
+    const base = new Float32Array(dims);
+    for (let i = 0; i < dims; i++) base[i] = template.positions[i] + m.mean[i];
+    geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
+    for (let k = 0; k < m.components; k++) targets.push(new THREE.BufferAttribute(m.basis.slice(k * dims, (k + 1) * dims), 3));
+    weights = m.coefficients;
+    maxErrorMm = m.maxError / unitsPerMm;
   }
+  geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
   geometry.morphAttributes.position = targets;
   geometry.morphTargetsRelative = true;
   geometry.computeVertexNormals();
@@ -40,8 +71,6 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   scene.add(mesh);
 
   const times = Float32Array.from({ length: frames }, (_, f) => f / animation.fps);
-  const weights = new Float32Array(frames * frames);
-  for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   const quats = new Float32Array(frames * 4);
   const moves = new Float32Array(frames * 3);
   const q = new THREE.Quaternion();
@@ -54,7 +83,7 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
     q.toArray(quats, f * 4);
     moves.set([p[3] * unitsPerMm, p[4] * unitsPerMm, p[5] * unitsPerMm], f * 3);
   }
-  const clip = new THREE.AnimationClip('speech', (frames - 1) / animation.fps, [
+  const clip = new THREE.AnimationClip('speech', Math.max(frames - 1, 0) / animation.fps, [
     new THREE.NumberKeyframeTrack(`${name}.morphTargetInfluences`, times, weights),
     new THREE.QuaternionKeyframeTrack(`${name}.quaternion`, times, quats),
     new THREE.VectorKeyframeTrack(`${name}.position`, times, moves),
@@ -62,7 +91,7 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   const bytes = (await new GLTFExporter().parseAsync(scene, { binary: true, animations: [clip] })) as ArrayBuffer;
   geometry.dispose();
   (mesh.material as THREE.Material).dispose();
-  return { bytes, frames, truncated: frames < animation.frames };
+  return { bytes, frames, encoding: exact ? 'per-frame' : 'components', morphTargets: targets.length, maxErrorMm };
 }
 
 /** Re-load a .glb with three.js: how many morph targets, animation clips and their duration. */

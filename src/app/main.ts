@@ -10,7 +10,7 @@ import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '..
 import type { LiveSession } from '../engine/live';
 import { decodeAudio, levels } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
-import { exportGlb, inspectGlb, rawFrames, download } from './export-glb';
+import { exportGlb, inspectGlb, rawFrames, download, GLB_COMPONENTS, GLB_EXACT_FRAMES } from './export-glb';
 
 const TEMPLATE_URL = '/models/template/template.json';
 const MANIFEST_URL = '/models/manifest.json';
@@ -551,13 +551,23 @@ canvas.addEventListener('click', (ev) => {
 });
 exportGlbButton.addEventListener('click', async () => {
   if (!take || !engine) return;
+  exportGlbButton.disabled = true;
   try {
+    if (take.animation.frames > GLB_EXACT_FRAMES) {
+      showStatus(`Preparing the .glb: finding the clip's ${GLB_COMPONENTS} strongest motion components…`);
+      await new Promise((r) => setTimeout(r, 30)); // let the message show before the work
+    }
     const glb = await exportGlb(take.animation, view.template, engine.unitsPerMm);
     download(new Blob([glb.bytes], { type: 'model/gltf-binary' }), `${take.name.replace(/\.[^.]+$/, '')}.glb`);
     showStatus(`Exported ${glb.frames} frames as .glb (${(glb.bytes.byteLength / 1e6).toFixed(1)} MB)` +
-      (glb.truncated ? `; the clip is longer, so only its first ${glb.frames} frames (one morph target per frame)` : '') + '.');
+      (glb.encoding === 'components'
+        ? `: the clip is longer than ${GLB_EXACT_FRAMES} frames, so its motion is ${glb.morphTargets} morph targets with per-frame weights ` +
+          `(largest deviation from the exact frames: ${glb.maxErrorMm.toFixed(2)} mm).`
+        : ', one morph target per frame.'));
   } catch (err) {
     showStatus(`Export failed: ${(err as Error).message}`, true);
+  } finally {
+    exportGlbButton.disabled = false;
   }
 });
 exportRawButton.addEventListener('click', () => {

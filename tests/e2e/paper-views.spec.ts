@@ -1,4 +1,5 @@
 import { test, expect, imageStats } from './fixtures';
+import { speechSamples, wav } from './helpers/audio';
 
 /**
  * What the paper shows, on a sample clip of the test split with its ground truth: error heat map (Fig. 5),
@@ -8,7 +9,7 @@ import { test, expect, imageStats } from './fixtures';
 type TF = {
   take: { name: string; animation: { frames: number; fps: number }; truth?: { frames: number } } | null;
   view: { scene: { getObjectByName(n: string): unknown } };
-  exportGlb(): Promise<{ bytes: ArrayBuffer; frames: number }>;
+  exportGlb(): Promise<{ bytes: ArrayBuffer; frames: number; encoding: string; morphTargets: number; maxErrorMm: number }>;
   inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number }>;
 };
 
@@ -58,9 +59,10 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   // .glb: re-loads in three.js with one morph target per frame and the clip's duration.
   const glb = await page.evaluate(async () => {
     const g = await (globalThis as unknown as { talkingFace: TF }).talkingFace.exportGlb();
-    return { frames: g.frames, info: await (globalThis as unknown as { talkingFace: TF }).talkingFace.inspectGlb(g.bytes) };
+    return { frames: g.frames, encoding: g.encoding, info: await (globalThis as unknown as { talkingFace: TF }).talkingFace.inspectGlb(g.bytes) };
   });
   expect(glb.frames).toBe(take.frames);
+  expect(glb.encoding).toBe('per-frame');
   expect(glb.info.morphTargets).toBe(take.frames);
   expect(glb.info.clips).toBe(1);
   expect(glb.info.vertices).toBe(468);
@@ -72,4 +74,32 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   const path = await download.path();
   const { statSync } = await import('node:fs');
   expect(statSync(path!).size).toBe(take.frames * 468 * 3 * 4);
+});
+
+test('a clip longer than a minute exports whole as a compact .glb: 8 morph targets, the deviation measured', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const { samples, rate } = speechSamples();
+  const long = new Float32Array(rate * 70); // 70 s: 2,100 frames, past the per-frame encoding's 1,800
+  for (let o = 0; o < long.length; o += samples.length + rate / 4) long.set(samples.subarray(0, Math.min(samples.length, long.length - o)), o);
+  await page.locator('#file-input').setInputFiles({ name: 'seventy.wav', mimeType: 'audio/wav', buffer: wav([long], rate) });
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 150_000 });
+  const frames = await page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.take!.animation.frames);
+  expect(frames).toBeGreaterThan(1800);
+  const glb = await page.evaluate(async () => {
+    const g = await (globalThis as unknown as { talkingFace: TF }).talkingFace.exportGlb();
+    return { ...g, bytes: g.bytes.byteLength, info: await (globalThis as unknown as { talkingFace: TF }).talkingFace.inspectGlb(g.bytes) };
+  });
+  console.log(`70 s clip: ${glb.frames} frames as ${glb.morphTargets} morph targets, ${(glb.bytes / 1e6).toFixed(2)} MB, largest deviation ${glb.maxErrorMm.toFixed(3)} mm`);
+  expect(glb.frames).toBe(frames);
+  expect(glb.encoding).toBe('components');
+  expect(glb.info.morphTargets).toBe(8);
+  expect(glb.info.vertices).toBe(468);
+  expect(glb.info.duration).toBeCloseTo((frames - 1) / 30, 3);
+  expect(glb.bytes).toBeLessThan(1e6); // per-frame targets would be ~28 MB
+  expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
+  // The page says what it did.
+  await page.locator('#export-glb').click();
+  await expect(page.locator('#status')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/);
 });
