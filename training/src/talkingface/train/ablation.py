@@ -98,6 +98,23 @@ def write_tables(results: dict, steps: int, seeds: list[int], corpus: str, out_d
         human = f"{t['E_vl_human']:.3f}" if t["E_vl_human"] is not None else "-"
         lines.append(f"| {r} | {t['E_vl']:.3f} | {t['E_ve']:.3f} | {t['FDD']:.4f} | {t['AFDD']:.4f} | {t['pose_error_deg']:.2f} | {human} | {PAPER_E_VL[r]} |")
     lines += ["", f"The paper's central ordering LG+GAVA < LG+SA < LG+MLP < G+MLP (E_vl) {verdict} here.", ""]
+    if len(seeds) > 1:
+        lines += ["E_vl per seed (the spread is the largest minus the smallest):", "",
+                  "| row | " + " | ".join(f"seed {s}" for s in seeds) + " | spread |",
+                  "| --- | " + " | ".join("---" for _ in seeds) + " | --- |"]
+        for r in order:
+            per = table[r]["per_seed"]
+            vals = [per[str(s)]["E_vl"] if str(s) in per else None for s in seeds]
+            got = [v for v in vals if v is not None]
+            lines.append(f"| {r} | " + " | ".join(f"{v:.3f}" if v is not None else "-" for v in vals)
+                         + f" | {max(got) - min(got):.3f} |")
+        lines.append("")
+        if all(r in table for r in claim):
+            for s in seeds:
+                if all(str(s) in table[r]["per_seed"] for r in claim):
+                    ok = all(table[a]["per_seed"][str(s)]["E_vl"] < table[b]["per_seed"][str(s)]["E_vl"] for a, b in zip(claim, claim[1:]))
+                    lines.append(f"Seed {s} alone: the ordering {'holds' if ok else 'does not hold'}.")
+            lines.append("")
     if rank:
         e = rank["explained"]
         lines += [f"Ground-truth motion of the training clips ({rank['frames']} frames, every 4th clip): the top 1 / 2 / 4 / 6 / 8 "

@@ -66,7 +66,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--checkpoint-every", type=int, default=200)
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
     ap.add_argument("--paper-loss", action="store_true", help="the paper's Eq. 3 exactly (no unposed or lip reconstruction terms; see losses.py)")
-    ap.add_argument("--silence", type=float, default=0.1,
+    ap.add_argument("--silence", type=float, default=0.2,
                     help="chance that a crop is pure silence with the rest face as target (data.py); 0 = the paper's data")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
