@@ -229,7 +229,11 @@ export function simdModule(): WebAssembly.Module | null {
   const bin = atob(WASM_BASE64);
   const bytes = new Uint8Array(bin.length);
   for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-  if (WebAssembly.validate(bytes)) module = new WebAssembly.Module(bytes);
+  try {
+    if (WebAssembly.validate(bytes)) module = new WebAssembly.Module(bytes);
+  } catch {
+    module = null; // e.g. a Content-Security-Policy without 'wasm-unsafe-eval': the TypeScript kernel runs
+  }
   return module;
 }
 
