@@ -198,21 +198,27 @@ describe('the fast decoder\'s kernels', () => {
     }
     expect(() => simd.matmul(simd.pack(wave(16, 1), wave(4, 1), 4, 4), simd.alloc(12), 3, simd.alloc(12))).toThrow(/even/);
     expect(() => simd.matmul(simd.pack(wave(16, 1), wave(4, 1), 4, 4), new Float32Array(8), 2, simd.alloc(8))).toThrow(/not allocated/);
-    // LayerNorm and GELU are float64 in both: the same bits.
+    // LayerNorm: float32 vectors where d is a multiple of 4, else float64 exactly as the TypeScript kernel.
     for (const d of [4, 7, 32]) {
       const X = wave(5 * d, 0.41, 3), g = wave(d, 0.2), bb = wave(d, 0.5);
       const want = new Float32Array(5 * d);
       jsKernel.layerNorm(X, 5, d, g, bb, want);
       const got = simd.alloc(5 * d);
       simd.layerNorm(simd.place(X), 5, d, simd.place(g), simd.place(bb), got);
-      expect(maxAbsDiff(got, want)).toBe(0);
+      if (d % 4) expect(maxAbsDiff(got, want)).toBe(0);
+      else expect(maxAbsDiff(got, want)).toBeLessThan(2e-6);
     }
-    const xs = Float32Array.from({ length: 20001 }, (_, i) => -10 + i / 1000);
-    const want = xs.slice();
-    jsKernel.gelu(want, want.length - 1); // the last element untouched in both
+    // GELU: vectors with the A&S erf (the reference decoder's formula) and the table for the remainder.
+    const xs = Float32Array.from({ length: 20003 }, (_, i) => -10 + i / 1000);
     const got = simd.place(xs);
-    simd.gelu(got, got.length - 1);
-    expect(maxAbsDiff(got, want)).toBe(0);
+    simd.gelu(got, got.length - 1); // 20,002 values: the last two of them by the table, the very last untouched
+    let worst = 0;
+    for (let i = 0; i < xs.length - 1; i++) worst = Math.max(worst, Math.abs(got[i] - gelu(xs[i])) / Math.max(1, Math.abs(xs[i])));
+    expect(worst).toBeLessThan(2e-7);
+    expect(got[xs.length - 1]).toBe(xs[xs.length - 1]);
+    const tail = xs.slice(20000, 20002);
+    jsKernel.gelu(tail, 2);
+    expect(Array.from(got.subarray(20000, 20002))).toEqual(Array.from(tail));
     // Residual sums, with a remainder after the vectors.
     const x = wave(23, 0.3), y = wave(23, 0.8);
     const sx = simd.place(x);

@@ -1,5 +1,6 @@
-;; The CPU decoder's layers in WebAssembly: matrix products, attention and residual sums in SIMD
-;; (four float lanes), LayerNorm and GELU in float64 exactly as fast-decoder.ts computes them.
+;; The CPU decoder's layers in WebAssembly SIMD (four float lanes): matrix products, attention,
+;; LayerNorm, GELU and residual sums. LayerNorm and GELU also in float64 exactly as the TypeScript
+;; kernel computes them (layer_norm_f64, gelu_table), used where the sizes are not multiples of 4.
 ;;
 ;; Assembled by `npm run build:wasm` (scripts/build-wasm.ts) into decoder-wasm.ts, which embeds the
 ;; bytes; a unit test assembles this file again and checks the embedded bytes are what it gives.
@@ -121,8 +122,8 @@
         (local.set $y (i32.add (local.get $y) (i32.const 4)))
         (br $one))))
 
-  ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps 1e-5)
-  (func (export "layer_norm") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+  ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps 1e-5), any d
+  (func $layer_norm_f64 (export "layer_norm_f64") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
     (local $t i32) (local $i i32) (local $row i32) (local $mean f64) (local $var f64) (local $c f64) (local $inv f64)
     (local $db i32)
     (local.set $db (i32.shl (local.get $d) (i32.const 2)))
@@ -166,8 +167,8 @@
         (br $rows_loop))))
 
   ;; GELU in place over a[0..count): the exact function tabulated (value, slope: float64, `steps` points
-  ;; per unit on [-range, range]) with cubic Hermite interpolation, as fast-decoder.ts's geluInPlace.
-  (func (export "gelu") (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
+  ;; per unit on [-range, range]) with cubic Hermite interpolation, as decoder-kernels.ts's geluInPlace.
+  (func $gelu_table (export "gelu_table") (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
     (local $end i32) (local $x f64) (local $u f64) (local $k f64) (local $s f64) (local $s2 f64) (local $s3 f64) (local $o i32)
     (local.set $end (i32.add (local.get $a) (i32.shl (local.get $count) (i32.const 2))))
     (block $done
@@ -323,4 +324,104 @@
           (br_if $heads_loop (i32.lt_u (local.get $hd) (local.get $heads))))
         (local.set $t (i32.add (local.get $t) (i32.const 1)))
         (br $tokens_loop))))
+
+  ;; Row-wise LayerNorm in float32 vectors: d a multiple of 4 (else the float64 version runs)
+  (func (export "layer_norm") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+    (local $t i32) (local $i i32) (local $row i32) (local $db i32) (local $acc v128) (local $mean v128) (local $c v128)
+    (local $inv v128) (local $m f32) (local $v f32)
+    (if (i32.and (local.get $d) (i32.const 3))
+      (then
+        (call $layer_norm_f64 (local.get $x) (local.get $rows) (local.get $d) (local.get $g) (local.get $b) (local.get $out))
+        (return)))
+    (local.set $db (i32.shl (local.get $d) (i32.const 2)))
+    (block $rows_done
+      (loop $rows_loop
+        (br_if $rows_done (i32.ge_u (local.get $t) (local.get $rows)))
+        (local.set $row (i32.add (local.get $x) (i32.mul (local.get $t) (local.get $db))))
+        (local.set $acc (v128.const f32x4 0 0 0 0))
+        (local.set $i (i32.const 0))
+        (loop $sum
+          (local.set $acc (f32x4.add (local.get $acc) (v128.load (i32.add (local.get $row) (local.get $i)))))
+          (local.set $i (i32.add (local.get $i) (i32.const 16)))
+          (br_if $sum (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $m (f32.div
+          (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
+                   (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc))))
+          (f32.convert_i32_u (local.get $d))))
+        (local.set $mean (f32x4.splat (local.get $m)))
+        (local.set $acc (v128.const f32x4 0 0 0 0))
+        (local.set $i (i32.const 0))
+        (loop $sq
+          (local.set $c (f32x4.sub (v128.load (i32.add (local.get $row) (local.get $i))) (local.get $mean)))
+          (local.set $acc (f32x4.add (local.get $acc) (f32x4.mul (local.get $c) (local.get $c))))
+          (local.set $i (i32.add (local.get $i) (i32.const 16)))
+          (br_if $sq (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $v (f32.div
+          (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
+                   (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc))))
+          (f32.convert_i32_u (local.get $d))))
+        (local.set $inv (f32x4.splat (f32.div (f32.const 1) (f32.sqrt (f32.add (local.get $v) (f32.const 1e-5))))))
+        (local.set $i (i32.const 0))
+        (loop $norm
+          (v128.store (i32.add (i32.add (local.get $out) (i32.mul (local.get $t) (local.get $db))) (local.get $i))
+            (f32x4.add
+              (f32x4.mul
+                (f32x4.mul (f32x4.sub (v128.load (i32.add (local.get $row) (local.get $i))) (local.get $mean)) (local.get $inv))
+                (v128.load (i32.add (local.get $g) (local.get $i))))
+              (v128.load (i32.add (local.get $b) (local.get $i)))))
+          (local.set $i (i32.add (local.get $i) (i32.const 16)))
+          (br_if $norm (i32.lt_u (local.get $i) (local.get $db))))
+        (local.set $t (i32.add (local.get $t) (i32.const 1)))
+        (br $rows_loop))))
+
+  ;; e^x in float32 vectors, for -87 < x <= 0: x = k ln 2 + r, a degree-6 polynomial for e^r, 2^k from the
+  ;; exponent bits
+  (func $exp4 (param $x v128) (result v128)
+    (local $k v128) (local $r v128)
+    (local.set $k (f32x4.nearest (f32x4.mul (local.get $x) (v128.const f32x4 1.442695 1.442695 1.442695 1.442695))))
+    (local.set $r (f32x4.sub
+      (f32x4.sub (local.get $x) (f32x4.mul (local.get $k) (v128.const f32x4 0.693359375 0.693359375 0.693359375 0.693359375)))
+      (f32x4.mul (local.get $k) (v128.const f32x4 -2.12194440e-4 -2.12194440e-4 -2.12194440e-4 -2.12194440e-4))))
+    (f32x4.mul
+      (f32x4.add (v128.const f32x4 1 1 1 1) (f32x4.mul (local.get $r)
+      (f32x4.add (v128.const f32x4 1 1 1 1) (f32x4.mul (local.get $r)
+      (f32x4.add (v128.const f32x4 0.5 0.5 0.5 0.5) (f32x4.mul (local.get $r)
+      (f32x4.add (v128.const f32x4 0.16666667 0.16666667 0.16666667 0.16666667) (f32x4.mul (local.get $r)
+      (f32x4.add (v128.const f32x4 0.041666668 0.041666668 0.041666668 0.041666668) (f32x4.mul (local.get $r)
+      (f32x4.add (v128.const f32x4 0.008333334 0.008333334 0.008333334 0.008333334) (f32x4.mul (local.get $r)
+        (v128.const f32x4 0.0013888889 0.0013888889 0.0013888889 0.0013888889)))))))))))))
+      (i32x4.shl (i32x4.add (i32x4.trunc_sat_f32x4_s (local.get $k)) (v128.const i32x4 127 127 127 127)) (i32.const 23))))
+
+  ;; GELU in place, float32 vectors: x/2 (1 + erf(x / sqrt 2)) with erf by Abramowitz & Stegun 7.1.26
+  ;; (|error| < 1.5e-7, the reference decoder's and the WGSL kernel's formula); the last count % 4
+  ;; values by the table (gelu_table's arguments after count)
+  (func (export "gelu") (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
+    (local $end4 i32) (local $x v128) (local $z v128) (local $t v128) (local $y v128)
+    (local.set $end4 (i32.add (local.get $a) (i32.shl (i32.and (local.get $count) (i32.const -4)) (i32.const 2))))
+    (block $done
+      (loop $each
+        (br_if $done (i32.ge_u (local.get $a) (local.get $end4)))
+        (local.set $x (v128.load (local.get $a)))
+        ;; z = min(|x| / sqrt 2, 6): erf(6) is 1 in float32
+        (local.set $z (f32x4.min (f32x4.mul (f32x4.abs (local.get $x)) (v128.const f32x4 0.70710677 0.70710677 0.70710677 0.70710677))
+                                 (v128.const f32x4 6 6 6 6)))
+        (local.set $t (f32x4.div (v128.const f32x4 1 1 1 1)
+          (f32x4.add (v128.const f32x4 1 1 1 1) (f32x4.mul (v128.const f32x4 0.3275911 0.3275911 0.3275911 0.3275911) (local.get $z)))))
+        ;; y = 1 - t (a1 + t (a2 + t (a3 + t (a4 + t a5)))) e^(-z^2)
+        (local.set $y (f32x4.sub (v128.const f32x4 1 1 1 1) (f32x4.mul
+          (f32x4.mul (local.get $t)
+            (f32x4.add (v128.const f32x4 0.254829592 0.254829592 0.254829592 0.254829592) (f32x4.mul (local.get $t)
+            (f32x4.add (v128.const f32x4 -0.284496736 -0.284496736 -0.284496736 -0.284496736) (f32x4.mul (local.get $t)
+            (f32x4.add (v128.const f32x4 1.421413741 1.421413741 1.421413741 1.421413741) (f32x4.mul (local.get $t)
+            (f32x4.add (v128.const f32x4 -1.453152027 -1.453152027 -1.453152027 -1.453152027) (f32x4.mul (local.get $t)
+              (v128.const f32x4 1.061405429 1.061405429 1.061405429 1.061405429))))))))))
+          (call $exp4 (f32x4.neg (f32x4.mul (local.get $z) (local.get $z)))))))
+        ;; erf takes the sign of x
+        (local.set $y (v128.bitselect (f32x4.neg (local.get $y)) (local.get $y) (f32x4.lt (local.get $x) (v128.const f32x4 0 0 0 0))))
+        (v128.store (local.get $a)
+          (f32x4.mul (f32x4.mul (v128.const f32x4 0.5 0.5 0.5 0.5) (local.get $x)) (f32x4.add (v128.const f32x4 1 1 1 1) (local.get $y))))
+        (local.set $a (i32.add (local.get $a) (i32.const 16)))
+        (br $each)))
+    (call $gelu_table (local.get $a) (i32.and (local.get $count) (i32.const 3))
+      (local.get $value) (local.get $slope) (local.get $range) (local.get $steps)))
 )
