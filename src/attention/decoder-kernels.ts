@@ -26,6 +26,7 @@ export interface DecoderKernel {
   /** A copy of `values` where this kernel can read it. */
   place(values: Float32Array): Float32Array;
   placeInts(values: Int32Array): Int32Array;
+  /** Scratch for attention scores: `length` float64 (the SIMD kernel uses the space as float32, plus padding). */
   scratch(length: number): Float64Array;
   pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight;
   /** out[t, o] = b[o] + sum_i W[o, i] X[t, i] for t < rows (rows even for SIMD). */

@@ -205,37 +205,18 @@
         (local.set $a (i32.add (local.get $a) (i32.const 4)))
         (br $each))))
 
-  ;; e^x for x <= 0 (softmax weights), float64: x = k ln 2 + r, |r| <= ln 2 / 2, a degree-8 Taylor
-  ;; polynomial for e^r (relative error < 1e-8), times 2^k built from the exponent bits.
-  (func $exp (param $x f64) (result f64)
-    (local $k f64) (local $r f64)
-    (if (f64.lt (local.get $x) (f64.const -700)) (then (local.set $x (f64.const -700))))
-    (local.set $k (f64.nearest (f64.mul (local.get $x) (f64.const 1.4426950408889634))))
-    (local.set $r (f64.sub (f64.sub (local.get $x) (f64.mul (local.get $k) (f64.const 0.6931471803691238)))
-                           (f64.mul (local.get $k) (f64.const 1.9082149292705877e-10))))
-    (f64.mul
-      (f64.add (f64.const 1) (f64.mul (local.get $r)
-      (f64.add (f64.const 1) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.5) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.16666666666666666) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.041666666666666664) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.008333333333333333) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.001388888888888889) (f64.mul (local.get $r)
-      (f64.add (f64.const 0.0001984126984126984) (f64.mul (local.get $r)
-        (f64.const 0.0000248015873015873)))))))))))))))))
-      (f64.reinterpret_i64 (i64.shl (i64.add (i64.trunc_f64_s (local.get $k)) (i64.const 1023)) (i64.const 52)))))
-  (export "exp" (func $exp))
 
   ;; Neighbour-masked multi-head attention over `tokens` tokens: qkv rows (tokens x 3d: queries, keys,
   ;; values), token t attends to keys key_index[key_start[t] .. key_start[t + 1]) (int32), softmax of
-  ;; q.k * scale per head, weights times values into out (tokens x d). `scores` is float64 scratch
-  ;; for the longest key list. Head size d / heads must be a multiple of 4.
+  ;; q.k * scale per head, weights times values into out (tokens x d). `scores`: float32 scratch for the
+  ;; longest key list plus 3, 16-byte aligned. Head size d / heads must be a multiple of 4. The softmax's
+  ;; exponentials go four keys at a time ($exp4; the lanes past the list are -87, weight ~1e-38).
   (func (export "attention")
     (param $qkv i32) (param $tokens i32) (param $d i32) (param $heads i32)
-    (param $key_start i32) (param $key_index i32) (param $scores i32) (param $out i32) (param $scale f64)
+    (param $key_start i32) (param $key_index i32) (param $scores i32) (param $out i32) (param $scale f32)
     (local $t i32) (local $hd i32) (local $s i32) (local $k0 i32) (local $k1 i32) (local $i i32)
     (local $row3 i32) (local $db i32) (local $dkb i32) (local $qo i32) (local $ko i32) (local $ao i32) (local $sp i32)
-    (local $acc v128) (local $w v128) (local $dot f64) (local $max f64) (local $sum f64) (local $e f64) (local $inv f64)
+    (local $acc v128) (local $w v128) (local $dot f32) (local $max f32) (local $inv f32) (local $m v128) (local $end i32)
     (local.set $db (i32.shl (local.get $d) (i32.const 2)))
     (local.set $row3 (i32.mul (local.get $db) (i32.const 3)))
     (local.set $dkb (i32.div_u (local.get $db) (local.get $heads)))
@@ -249,7 +230,7 @@
           (local.set $qo (i32.add (local.get $qkv)
             (i32.add (i32.mul (local.get $t) (local.get $row3)) (i32.mul (local.get $hd) (local.get $dkb)))))
           ;; scores and their maximum
-          (local.set $max (f64.const -inf))
+          (local.set $max (f32.const -inf))
           (local.set $s (local.get $k0))
           (local.set $sp (local.get $scores))
           (block $scored
@@ -269,28 +250,32 @@
                     (f32x4.mul (v128.load (i32.add (local.get $qo) (local.get $i))) (v128.load (i32.add (local.get $ko) (local.get $i))))))
                   (local.set $i (i32.add (local.get $i) (i32.const 16)))
                   (br $dot_loop)))
-              (local.set $dot (f64.mul (local.get $scale) (f64.promote_f32
+              (local.set $dot (f32.mul (local.get $scale)
                 (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
-                         (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc)))))))
-              (f64.store (local.get $sp) (local.get $dot))
-              (if (f64.gt (local.get $dot) (local.get $max)) (then (local.set $max (local.get $dot))))
-              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
+                         (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc))))))
+              (f32.store (local.get $sp) (local.get $dot))
+              (local.set $max (f32.max (local.get $max) (local.get $dot)))
+              (local.set $sp (i32.add (local.get $sp) (i32.const 4)))
               (local.set $s (i32.add (local.get $s) (i32.const 1)))
               (br $score_loop)))
-          ;; softmax
-          (local.set $sum (f64.const 0))
+          ;; softmax, four keys at a time: pad the list to a multiple of 4 with scores that vanish
+          (f32.store offset=0 (local.get $sp) (f32.const -1e30))
+          (f32.store offset=4 (local.get $sp) (f32.const -1e30))
+          (f32.store offset=8 (local.get $sp) (f32.const -1e30))
+          (local.set $end (i32.add (local.get $scores) (i32.shl (i32.sub (local.get $k1) (local.get $k0)) (i32.const 2))))
+          (local.set $m (f32x4.splat (local.get $max)))
+          (local.set $acc (v128.const f32x4 0 0 0 0))
           (local.set $sp (local.get $scores))
-          (local.set $s (local.get $k0))
-          (block $exped
-            (loop $exp_loop
-              (br_if $exped (i32.ge_u (local.get $s) (local.get $k1)))
-              (local.set $e (call $exp (f64.sub (f64.load (local.get $sp)) (local.get $max))))
-              (f64.store (local.get $sp) (local.get $e))
-              (local.set $sum (f64.add (local.get $sum) (local.get $e)))
-              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
-              (local.set $s (i32.add (local.get $s) (i32.const 1)))
-              (br $exp_loop)))
-          (local.set $inv (f64.div (f64.const 1) (local.get $sum)))
+          (loop $exp_loop
+            (local.set $w (call $exp4 (f32x4.max (f32x4.sub (v128.load (local.get $sp)) (local.get $m))
+                                                 (v128.const f32x4 -87 -87 -87 -87))))
+            (v128.store (local.get $sp) (local.get $w))
+            (local.set $acc (f32x4.add (local.get $acc) (local.get $w)))
+            (local.set $sp (i32.add (local.get $sp) (i32.const 16)))
+            (br_if $exp_loop (i32.lt_u (local.get $sp) (local.get $end))))
+          (local.set $inv (f32.div (f32.const 1)
+            (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
+                     (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc))))))
           ;; weighted sum of the values
           (local.set $ao (i32.add (local.get $out)
             (i32.add (i32.mul (local.get $t) (local.get $db)) (i32.mul (local.get $hd) (local.get $dkb)))))
@@ -304,7 +289,7 @@
           (block $summed
             (loop $value_loop
               (br_if $summed (i32.ge_u (local.get $s) (local.get $k1)))
-              (local.set $w (f32x4.splat (f32.demote_f64 (f64.mul (f64.load (local.get $sp)) (local.get $inv)))))
+              (local.set $w (f32x4.splat (f32.mul (f32.load (local.get $sp)) (local.get $inv))))
               (local.set $ko (i32.add (local.get $qkv)
                 (i32.add (i32.add (i32.mul (i32.load (i32.add (local.get $key_index) (i32.shl (local.get $s) (i32.const 2))))
                                            (local.get $row3))
@@ -317,7 +302,7 @@
                              (f32x4.mul (local.get $w) (v128.load (i32.add (local.get $ko) (local.get $i))))))
                 (local.set $i (i32.add (local.get $i) (i32.const 16)))
                 (br_if $acc_loop (i32.lt_u (local.get $i) (local.get $dkb))))
-              (local.set $sp (i32.add (local.get $sp) (i32.const 8)))
+              (local.set $sp (i32.add (local.get $sp) (i32.const 4)))
               (local.set $s (i32.add (local.get $s) (i32.const 1)))
               (br $value_loop)))
           (local.set $hd (i32.add (local.get $hd) (i32.const 1)))
