@@ -10,7 +10,10 @@ labelled silence), so a model trained on them alone never learns what a long sil
 and leaves the mouth ajar when a microphone hears nothing. A silence crop is a stretch (warm-up and
 crop, over a second) of digital silence or faint noise (-90 to -50 dBFS) whose target is the subject's rest face: the
 frame of its clips, among those labelled silence with the eyes open, where the inner lips are
-closest, with the head in its neutral pose. Nothing here assumes our corpus: unlabelled data
+closest, with the head in its neutral pose. Half the silence crops sit at the very start of the signal:
+the corpus's clips open the mouth during their leading silence (the speech follows within a few
+hundred ms), and a model trained on those alone opens the mouth at the start of any recording, 3 mm
+in the first 0.3 s of pure silence. Nothing here assumes our corpus: unlabelled data
 counts every frame as silence, and the rest face is then the subject's most closed-mouth frame.
 """
 from __future__ import annotations
@@ -133,7 +136,9 @@ def sample_batch(clips: list[PreparedClip], rng: np.random.Generator, n_clips: i
         if silence > 0 and rng.random() < silence:
             if c.rest is None:
                 raise ValueError("silence crops need the rest faces: call attach_rest_faces first")
-            f0 = int(np.ceil(WARMUP_SECONDS * audio.fps))
+            # Half of them at the very start of a signal (the encoders' edge padding in view), half a
+            # second or more in: a recording that starts silent must not open the mouth either.
+            f0 = 0 if rng.random() < 0.5 else int(np.ceil(WARMUP_SECONDS * audio.fps))
             fr = np.arange(f0, f0 + frames)
             mi = frame_to_mel_index(fr, audio)
             k0 = max(0, mi[0] - warm)
