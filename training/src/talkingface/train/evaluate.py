@@ -121,8 +121,9 @@ def markdown(res: dict, args, ck: dict) -> str:
         "",
         "Lip motion: mean over frames of the largest lip-vertex displacement from the neutral face.",
         f"Baseline: a face that never moves scores E_vl {res['all']['E_vl_still_face']:.3f} mm on the same clips.",
-        f"Silence (2 s of zeros): the inner lips are left {res['silence']['lip_gap_mean_mm']:.2f} mm apart on average "
-        f"(at most {res['silence']['lip_gap_max_mm']:.2f}; the neutral template: {res['silence']['neutral_template_gap_mm']:.2f}).",
+        f"Silence (2 s of zeros): inner-lip gap {res['silence']['lip_gap_mean_mm']:.2f} mm on average, at most "
+        f"{res['silence']['lip_gap_max_mm']:.2f} (0 = touching, below 0 pressed together; the neutral template: "
+        f"{res['silence']['neutral_template_gap_mm']:.2f}).",
         "",
     ])
 
