@@ -24,6 +24,7 @@ test('microphone -> worklet -> streaming engine: frames equal the offline animat
   expect(r.streamVsOffline).toBeLessThan(1e-5);
   expect(r.latency.frames).toBeGreaterThan(10);
   expect(Number.isFinite(r.latency.p50Ms)).toBe(true);
+  console.log(`live capture (fake microphone -> AudioWorklet -> engine): latency p50 ${r.latency.p50Ms.toFixed(0)} ms over ${r.latency.frames} frames (look-ahead ${r.lookAheadMs.toFixed(0)} ms)`);
   expect(r.lookAheadMs).toBeLessThanOrEqual(150);
   expect(r.tracksEnded, 'stop() released the microphone').toBe(true);
   const range = (Math.max(...r.gaps) - Math.min(...r.gaps)) * r.mmPerUnit;
