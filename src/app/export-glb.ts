@@ -40,23 +40,19 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   let weights: Float32Array;
   let maxErrorMm = 0;
   const exact = frames <= GLB_EXACT_FRAMES;
+  const D = new Float32Array(frames * dims); // per frame: I + O minus I
+  for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) D[f * dims + i] = animation.unposed[f * dims + i] - template.positions[i];
   if (exact) {
     geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(template.positions), 3));
-    for (let f = 0; f < frames; f++) {
-      const d = new Float32Array(dims);
-      for (let i = 0; i < dims; i++) d[i] = animation.unposed[f * dims + i] - template.positions[i];
-      targets.push(new THREE.BufferAttribute(d, 3));
-    }
+    for (let f = 0; f < frames; f++) targets.push(new THREE.BufferAttribute(D.subarray(f * dims, (f + 1) * dims), 3));
     weights = new Float32Array(frames * frames);
     for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   } else {
-    const D = new Float32Array(frames * dims);
-    for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) D[f * dims + i] = animation.unposed[f * dims + i] - template.positions[i];
     const m = motionBasis(D, frames, dims, GLB_COMPONENTS);
     const base = new Float32Array(dims);
     for (let i = 0; i < dims; i++) base[i] = template.positions[i] + m.mean[i];
     geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
-    for (let k = 0; k < m.components; k++) targets.push(new THREE.BufferAttribute(m.basis.slice(k * dims, (k + 1) * dims), 3));
+    for (let k = 0; k < m.components; k++) targets.push(new THREE.BufferAttribute(m.basis.subarray(k * dims, (k + 1) * dims), 3));
     weights = m.coefficients;
     maxErrorMm = m.maxError / unitsPerMm;
   }

@@ -123,7 +123,7 @@
         (br $one))))
 
   ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps 1e-5), any d
-  (func $layer_norm_f64 (export "layer_norm_f64") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+  (func $layer_norm_f64 (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
     (local $t i32) (local $i i32) (local $row i32) (local $mean f64) (local $var f64) (local $c f64) (local $inv f64)
     (local $db i32)
     (local.set $db (i32.shl (local.get $d) (i32.const 2)))
@@ -168,7 +168,7 @@
 
   ;; GELU in place over a[0..count): the exact function tabulated (value, slope: float64, `steps` points
   ;; per unit on [-range, range]) with cubic Hermite interpolation, as decoder-kernels.ts's geluInPlace.
-  (func $gelu_table (export "gelu_table") (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
+  (func $gelu_table (param $a i32) (param $count i32) (param $value i32) (param $slope i32) (param $range f64) (param $steps f64)
     (local $end i32) (local $x f64) (local $u f64) (local $k f64) (local $s f64) (local $s2 f64) (local $s3 f64) (local $o i32)
     (local.set $end (i32.add (local.get $a) (i32.shl (local.get $count) (i32.const 2))))
     (block $done

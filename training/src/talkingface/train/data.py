@@ -79,12 +79,16 @@ class Batch:
     pose: torch.Tensor        # (B, T, 6)
 
 
-def attach_rest_faces(clips: list[PreparedClip], template: Template) -> dict[str, float]:
+def attach_rest_faces(clips: list[PreparedClip], template: Template, audio: AudioConfig = AudioConfig()) -> dict[str, float]:
     """Give every clip its subject's rest face (subjects told apart by their neutral template).
     -> per subject, the rest face's inner-lip gap in mm (for the training log)."""
     r = template.regions
-    up, lo = r["lips_inner_upper"], r["lips_inner_lower"]
     eyes = [(r[f"eye_{s}_upper"], r[f"eye_{s}_lower"]) for s in ("left", "right")]
+
+    def candidates(v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """frames -> (frames, inner-lip gap, the smaller eye opening)"""
+        return v, contour_gap(v, r["lips_inner_upper"], r["lips_inner_lower"]), np.minimum(*[contour_gap(v, u, l) for u, l in eyes])
+
     silence = PHONE_INDEX[SILENCE]
     groups: dict[bytes, list[PreparedClip]] = {}
     for c in clips:
@@ -93,18 +97,13 @@ def attach_rest_faces(clips: list[PreparedClip], template: Template) -> dict[str
     for n, group in enumerate(groups.values()):
         cand = []
         for c in group:
-            mi = np.clip(frame_to_mel_index(np.arange(c.num_frames)), 0, len(c.phones) - 1)
+            mi = np.clip(frame_to_mel_index(np.arange(c.num_frames), audio), 0, len(c.phones) - 1)
             quiet = np.flatnonzero(c.phones[mi] == silence)
             if len(quiet):
-                v = c.vertices[quiet]
-                eye = np.minimum(*[contour_gap(v, u, l) for u, l in eyes])
-                cand.append((v, contour_gap(v, up, lo), eye))
+                cand.append(candidates(c.vertices[quiet]))
         if not cand:  # no frame labelled silence: every frame is a candidate
-            cand = [(c.vertices, contour_gap(c.vertices, up, lo), np.minimum(*[contour_gap(c.vertices, u, l) for u, l in eyes]))
-                    for c in group]
-        v = np.concatenate([x[0] for x in cand])
-        lip = np.concatenate([x[1] for x in cand])
-        eye = np.concatenate([x[2] for x in cand])
+            cand = [candidates(c.vertices) for c in group]
+        v, lip, eye = (np.concatenate(parts) for parts in zip(*cand))
         open_eyes = eye >= 0.9 * eye.max()
         best = np.flatnonzero(open_eyes)[np.argmin(lip[open_eyes])]
         for c in group:

@@ -97,7 +97,7 @@ def main(argv=None) -> int:
         f"prepared in {time.time() - t0:.0f} s; {world} process(es)")
 
     if args.silence > 0:
-        gaps = attach_rest_faces(clips, ds.template)
+        gaps = attach_rest_faces(clips, ds.template, audio)
         log(f"silence crops: {args.silence:.0%} of crops; rest faces' inner-lip gap {min(gaps.values()):.2f}-{max(gaps.values()):.2f} mm "
             f"({len(gaps)} subjects)")
 
