@@ -53,26 +53,38 @@ ensure_corpus_tools() {
   venv_python -m talkingface.corpus setup >&2
 }
 
-ensure_venv() {
+# uv (pinned in scripts/uv-requirements.txt by version and hash) resolves nothing at setup time: it installs
+# exactly what training/uv.lock lists, every transitive package with its version and hash.
+UV_VERSION="$(sed -n 's/^uv==\([0-9.]*\).*/\1/p' "$REPO_ROOT/scripts/uv-requirements.txt")"
+UV_HOME="${TALKING_FACE_UV_HOME:-$HOME/.cache/talking-face/uv}"
+
+ensure_uv() {
+  if command -v uv >/dev/null && [ "$(uv --version | cut -d' ' -f2)" = "$UV_VERSION" ]; then UV=uv; return 0; fi
+  UV="$UV_HOME/bin/uv"
+  if [ -x "$UV" ] && [ "$("$UV" --version | cut -d' ' -f2)" = "$UV_VERSION" ]; then return 0; fi
   local py="${PYTHON:-python3}"
   "$py" -c 'import sys; assert sys.version_info >= (3, 11)' 2>/dev/null ||
     { say "Python 3.11+ is required (found: $("$py" --version 2>&1))"; return 1; }
-  # The dependency list in training/pyproject.toml is the single source; its hash names the install.
-  local deps want
-  deps="$("$py" - "$REPO_ROOT/training/pyproject.toml" <<'PY'
-import sys, tomllib
-p = tomllib.load(open(sys.argv[1], "rb"))["project"]
-print("\n".join(p["dependencies"] + sum(p.get("optional-dependencies", {}).values(), [])))
-PY
-)"
-  want="$(printf '%s' "$deps" | sha256sum | cut -d' ' -f1)"
-  if [ -f "$TALKING_FACE_VENV/.deps-sha256" ] && [ "$(cat "$TALKING_FACE_VENV/.deps-sha256")" = "$want" ]; then return 0; fi
-  say "creating the Python venv at $TALKING_FACE_VENV (PyTorch is a large download; this happens once)"
-  [ -x "$TALKING_FACE_VENV/bin/python" ] || "$py" -m venv "$TALKING_FACE_VENV"
-  local -a reqs
-  mapfile -t reqs <<<"$deps"
-  "$TALKING_FACE_VENV/bin/python" -m pip install --disable-pip-version-check -q "${reqs[@]}"
-  echo "$want" >"$TALKING_FACE_VENV/.deps-sha256"
+  say "installing uv $UV_VERSION into $UV_HOME (hash-checked)"
+  rm -rf "$UV_HOME"
+  "$py" -m venv "$UV_HOME"
+  "$UV_HOME/bin/python" -m pip install --disable-pip-version-check -q --require-hashes \
+    -r "$REPO_ROOT/scripts/uv-requirements.txt"
+}
+
+ensure_venv() {
+  # The venv is named by the lock's hash: a changed lock (or pyproject.toml) rebuilds it.
+  local want
+  want="$(cat "$REPO_ROOT/training/uv.lock" "$REPO_ROOT/training/pyproject.toml" | sha256sum | cut -d' ' -f1)"
+  if [ -f "$TALKING_FACE_VENV/.lock-sha256" ] && [ "$(cat "$TALKING_FACE_VENV/.lock-sha256")" = "$want" ]; then return 0; fi
+  ensure_uv
+  say "syncing the Python venv at $TALKING_FACE_VENV with training/uv.lock (PyTorch is a large download the first time)"
+  rm -f "$TALKING_FACE_VENV/.lock-sha256"
+  # --locked: fail rather than re-resolve if the lock no longer matches pyproject.toml.
+  # --no-install-project: the toolkit runs from the checkout's sources (venv_python), so nothing goes stale.
+  (cd "$REPO_ROOT/training" && UV_PROJECT_ENVIRONMENT="$TALKING_FACE_VENV" "$UV" sync --locked --extra test \
+    --no-install-project --python "${PYTHON:-python3}" --quiet)
+  echo "$want" >"$TALKING_FACE_VENV/.lock-sha256"
 }
 
 # Run the toolkit's Python with the checkout's sources on the path (no install step to go stale).

@@ -33,6 +33,24 @@ def test_small_preset_layout(corpus):
     for folder, ext in (("wav", "wav"), ("vertices_npy", "npy"), ("poses_npy", "npy"), ("alignments", "json")):
         assert len(list((root / folder).glob(f"*.{ext}"))) == n
     assert set(corpus.subject_templates) == {s["name"] for s in meta["subjects"]}
+    assert meta["tool_versions"]["flite"] != "not installed" and meta["tool_versions"]["pocketsphinx"]
+
+
+def test_missing_recordings_stop_the_build_and_never_shift_the_other_clips(monkeypatch):
+    """Issue 12: without the transcripts package the plan used to skip a random draw per clip, so every
+    later clip got another voice and tempo. Now it stops with the packages to install; and the TTS clips of a
+    plan without recorded speech are exactly those of the plan with it."""
+    from dataclasses import replace
+
+    from talkingface.corpus import recorded
+    cfg = PRESETS["small"]
+    _, with_rec = plan(cfg)
+    monkeypatch.setattr(recorded, "available", lambda: False)
+    with pytest.raises(Exception, match="asterisk-core-sounds-en"):
+        plan(cfg)
+    _, without = plan(replace(cfg, human_fraction=0.0))
+    tts = [(a.key, a.voice, a.text) for a in with_rec if a.recording is None]
+    assert len(tts) > 3 and tts == [(b.key, b.voice, b.text) for b in without if b.key in {k for k, _, _ in tts}]
 
 
 def test_lips_touch_at_every_bilabial(corpus):

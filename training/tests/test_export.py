@@ -1,5 +1,6 @@
 """The browser artefacts: ONNX equals PyTorch, the manifest matches the files, the committed models/ is what the exporter writes."""
 import json
+import shutil
 
 import numpy as np
 import onnxruntime as ort
@@ -7,6 +8,8 @@ import pytest
 import torch
 
 from talkingface import export
+from talkingface.artefacts import compare_exports
+from talkingface.safetensors import read_safetensors, write_safetensors
 from talkingface.paths import MODELS_DIR
 from talkingface.train import train
 
@@ -75,9 +78,54 @@ def test_manifest_matches_the_files(exported):
     assert manifest["tokens"]["pose_token_index"] == model.num_vertices
 
 
-def test_committed_models_are_what_the_exporter_writes(tmp_path):
-    manifest = json.loads((MODELS_DIR / "manifest.json").read_text())
-    for name, path in manifest["files"].items():
-        assert export.sha256(MODELS_DIR / path) == manifest["sha256"][name], f"models/{path} was changed by hand"
-    again = export.export(MODELS_DIR / "checkpoint.pt", tmp_path)
-    assert again["sha256"] == manifest["sha256"], "models/ is stale: rerun scripts/py -m talkingface.export"
+@pytest.fixture(scope="module")
+def reexported(tmp_path_factory):
+    """The shipped checkpoint exported afresh by this machine's exporter."""
+    out = tmp_path_factory.mktemp("reexport")
+    export.export(MODELS_DIR / "checkpoint.pt", out)
+    return out
+
+
+def test_committed_models_are_what_the_exporter_writes(reexported):
+    problems, diffs = compare_exports(MODELS_DIR, reexported)
+    print("\n".join(map(str, diffs)))  # pytest -s shows how far the fixtures are from this machine's numbers
+    assert not problems, "models/ is stale: rerun scripts/py -m talkingface.export\n" + "\n".join(problems)
+
+
+def copy_export(src, dst):
+    shutil.copytree(src, dst)
+    return dst
+
+
+def test_a_last_bit_difference_in_a_fixture_passes(reexported, tmp_path):
+    other = copy_export(reexported, tmp_path / "m")
+    fx = read_safetensors(other / "fixtures" / "fixtures.safetensors")
+    for name, a in fx.items():
+        if a.dtype == np.float32:  # every value one ulp away, as another BLAS kernel might compute it
+            fx[name] = np.nextafter(a, np.float32(np.inf))
+    write_safetensors(other / "fixtures" / "fixtures.safetensors", fx, {"frames": "x"})
+    problems, diffs = compare_exports(other, reexported)
+    assert [p for p in problems if "does not match its manifest hash" not in p] == []
+    assert max(d.max_abs for d in diffs) > 0
+
+
+def test_a_changed_weight_fails(reexported, tmp_path):
+    other = copy_export(reexported, tmp_path / "m")
+    w = read_safetensors(other / "gava.safetensors")
+    name = sorted(w)[0]
+    w[name].flat[0] += 0.01 * np.abs(w[name]).max()
+    write_safetensors(other / "gava.safetensors", w)
+    manifest = json.loads((other / "manifest.json").read_text())
+    manifest["sha256"]["decoder_weights"] = export.sha256(other / "gava.safetensors")  # even with its hash updated
+    (other / "manifest.json").write_text(json.dumps(manifest))
+    problems, _ = compare_exports(other, reexported)
+    assert any("decoder_weights" in p and "serialised weights differ" in p for p in problems), problems
+
+
+def test_a_changed_fixture_value_fails(reexported, tmp_path):
+    other = copy_export(reexported, tmp_path / "m")
+    fx = read_safetensors(other / "fixtures" / "fixtures.safetensors")
+    fx["vertices"][0, 0, 0] += 0.05  # mm: far more than rounding, far less than anything visible
+    write_safetensors(other / "fixtures" / "fixtures.safetensors", fx)
+    problems, _ = compare_exports(other, reexported)
+    assert any("vertices" in p and "over tolerance" in p for p in problems), problems

@@ -17,10 +17,8 @@ The checkpoint given (weights and configs, no optimiser state) is copied to mode
 from __future__ import annotations
 
 import argparse
-import hashlib
 import io
 import json
-import struct
 import sys
 import warnings
 from pathlib import Path
@@ -33,41 +31,11 @@ from .data.datasets import read_wav
 from .features import AudioConfig, frame_to_mel_index, log_mel
 from .model.gava import TalkingFace
 from .paths import MODELS_DIR, TEMPLATE_DIR
+from .safetensors import read_safetensors, sha256, write_safetensors
 from .template import load_template
 
 MANIFEST_FORMAT = "talking-face-model"
 OPSET = 17
-
-
-def write_safetensors(path: Path, tensors: dict[str, np.ndarray], metadata: dict[str, str] | None = None) -> None:
-    """The safetensors layout: u64 header size, JSON header (dtype, shape, byte range per tensor), raw little-endian data."""
-    header, blobs, offset = {}, [], 0
-    for name in sorted(tensors):
-        a = np.ascontiguousarray(tensors[name])
-        dtype = {np.dtype("float32"): "F32", np.dtype("int64"): "I64", np.dtype("int32"): "I32", np.dtype("uint32"): "U32"}[a.dtype]
-        raw = a.astype(a.dtype.newbyteorder("<")).tobytes()
-        header[name] = {"dtype": dtype, "shape": list(a.shape), "data_offsets": [offset, offset + len(raw)]}
-        blobs.append(raw)
-        offset += len(raw)
-    if metadata:
-        header["__metadata__"] = metadata
-    text = json.dumps(header, separators=(",", ":")).encode()
-    text += b" " * (-len(text) % 8)  # align the data to 8 bytes
-    path.write_bytes(struct.pack("<Q", len(text)) + text + b"".join(blobs))
-
-
-def read_safetensors(path: Path) -> dict[str, np.ndarray]:
-    raw = path.read_bytes()
-    n = struct.unpack("<Q", raw[:8])[0]
-    header = json.loads(raw[8 : 8 + n])
-    out = {}
-    for name, spec in header.items():
-        if name == "__metadata__":
-            continue
-        dt = {"F32": "<f4", "I64": "<i8", "I32": "<i4", "U32": "<u4"}[spec["dtype"]]
-        a, b = spec["data_offsets"]
-        out[name] = np.frombuffer(raw[8 + n + a : 8 + n + b], dtype=dt).reshape(spec["shape"]).copy()  # writable
-    return out
 
 
 class _PoseLSTM(nn.Module):
@@ -139,10 +107,6 @@ def receptive_field(model: TalkingFace) -> dict:
             content_reach = max(content_reach, probe - int(torch.nonzero(c > 0)[0]) * cfg.content_stride)
             pose_reach = max(pose_reach, probe - int(torch.nonzero(p > 0)[0]))
     return {"content_mel_frames": content_reach, "pose_mel_frames": pose_reach}
-
-
-def sha256(path: Path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 FIXTURE_SECONDS = 0.6     # a short clip keeps the fixtures small

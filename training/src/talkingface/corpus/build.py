@@ -38,7 +38,7 @@ from .pose import apply_pose, head_pose_track, pose_about_pivot
 from .prosody import frame_energy, frame_pitch, zscore_voiced
 from .rig import Rig
 from .sentences import generate_sentences
-from .speech import SpeechToolError, Voice, all_voices, fit_to_duration, resample, synthesize
+from .speech import SpeechToolError, Voice, all_voices, fit_to_duration, resample, synthesize, tool_versions
 from .phonemes import SILENCE
 
 CORPUS_VERSION = 1
@@ -104,7 +104,11 @@ def plan(cfg: CorpusConfig) -> tuple[list[Subject], list[ClipSpec]]:
     voice_pool = {"train": [v for v in voices if not is_test_voice(v)], "test": [v for v in voices if is_test_voice(v)]}
     voice_pool["val"] = voice_pool["train"]
     human = {"train": [], "val": [], "test": []}
-    if recorded.available():
+    if cfg.human_fraction > 0:
+        # A corpus that silently lacked its recorded speech would be another corpus (issue 12: a fresh machine
+        # missed the transcripts package, and every later clip drew other voices and tempos).
+        if not recorded.available():
+            raise SpeechToolError(f"recorded speech missing: {recorded.MISSING_HINT}")
         for r in recorded.recordings():
             human[_split_of_recording(r.name)].append(r)
     cursors = {k: 0 for k in sentences}
@@ -128,7 +132,9 @@ def plan(cfg: CorpusConfig) -> tuple[list[Subject], list[ClipSpec]]:
             others = [pool[i] for i in rng.permutation(len(pool))[:3]]
             timed = [v for v in pool if v.timing == "synthesiser"]
             spec.fallback_voices = [asdict(v) for v in others + [timed[rng.integers(len(timed))]]]
-            if human[split] and rng.random() < cfg.human_fraction:
+            # Drawn for every clip, so the draws of later clips never depend on which recordings exist.
+            wants_human = rng.random() < cfg.human_fraction
+            if human[split] and wants_human:
                 spec.recording = human[split][cursors.setdefault("h" + split, 0) % len(human[split])].name
                 cursors["h" + split] += 1
             else:
@@ -315,6 +321,8 @@ def build_corpus(out: Path, cfg: CorpusConfig, workers: int = 2, template_path: 
                    "test": sorted({v.id for v in all_voices() if is_test_voice(v)})},
         "clips": len(records), "hours": round(sum(r["duration"] for r in records) / 3600, 4),
         "build_seconds": round(seconds, 1), "workers": workers,
+        # The speech and the alignments depend on these tools' versions: a corpus is reproduced with the same ones.
+        "tool_versions": tool_versions(),
         "pose_convention": "poses_npy: (frames, 6) = axis-angle (rad) and translation; posed y = R (I + O) + t",
         "frame_convention": "frame i shows the face at t = i / fps",
     }

@@ -13,6 +13,10 @@ from pathlib import Path
 
 SOUNDS_DIR = Path("/usr/share/asterisk/sounds/en_US_f_Allison")
 TRANSCRIPTS = Path("/usr/share/doc/asterisk-core-sounds-en/core-sounds-en.txt.gz")
+# The WAV files and the transcripts are two Debian packages (the second is only a Recommends of the first).
+PACKAGES = ("asterisk-core-sounds-en-wav", "asterisk-core-sounds-en")
+MISSING_HINT = (f"{SOUNDS_DIR} and {TRANSCRIPTS} come from the Debian packages {' and '.join(PACKAGES)}: "
+                "install them with `scripts/py -m talkingface.corpus setup`")
 LICENSE = "CC-BY-SA-3.0 (Debian package asterisk-core-sounds-en-wav, voice: Allison Smith)"
 
 

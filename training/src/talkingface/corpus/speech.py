@@ -30,8 +30,9 @@ ESPEAK_VARIANTS = ("f1", "f2", "f3", "f4", "f5", "m1", "m2", "m5", "m6", "klatt"
 
 ESPEAK_PAD = 0.2  # seconds of silence added before and after espeak-ng speech
 
+# asterisk-core-sounds-en holds the recordings' transcripts; setup installs without Recommends, so it is named here.
 DEBIAN_PACKAGES = ("festival", "festvox-kallpc16k", "festvox-kdlpc16k", "festvox-us-slt-hts", "flite", "espeak-ng", "sox",
-                   "asterisk-core-sounds-en-wav")
+                   "asterisk-core-sounds-en-wav", "asterisk-core-sounds-en")
 
 
 class SpeechToolError(RuntimeError):
@@ -61,6 +62,21 @@ def all_voices() -> list[Voice]:
         for v in ESPEAK_VARIANTS:
             voices.append(Voice("espeak", f"{a}+{v}"))
     return voices
+
+
+def tool_versions() -> dict[str, str]:
+    """The versions the corpus's speech and alignments depend on: the Debian packages (dpkg) and pocketsphinx."""
+    from importlib.metadata import PackageNotFoundError, version
+    out = {}
+    for p in DEBIAN_PACKAGES:
+        r = subprocess.run(["dpkg-query", "-W", "-f=${Version}", p], capture_output=True, text=True)
+        out[p] = r.stdout.strip() if r.returncode == 0 and r.stdout.strip() else "not installed"
+    for p in ("pocketsphinx", "numpy"):
+        try:
+            out[p] = version(p)
+        except PackageNotFoundError:
+            out[p] = "not installed"
+    return out
 
 
 def require_tools(*tools: str) -> None:
