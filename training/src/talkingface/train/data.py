@@ -43,6 +43,7 @@ class PreparedClip:
     pose: np.ndarray            # (F, 6) axis-angle (rad), translation (mm)
     source: str                 # "tts" or "human" (recorded speech)
     rest: np.ndarray | None = None  # (N, 3) the subject's rest face, mm (set by attach_rest_faces)
+    segments: list | None = None    # [(phone, start s, end s)] as aligned, for the articulation measures
 
     @property
     def num_frames(self) -> int:
@@ -66,7 +67,7 @@ def prepare(ds: FaceDataset, key: str, audio: AudioConfig = AudioConfig()) -> Pr
     pose = pose.copy()
     pose[:, 3:] *= mm
     return PreparedClip(key, mel, phones, clip.vertices * mm, clip.template * mm, pose.astype(np.float32),
-                        clip.meta.get("source", "real"))
+                        clip.meta.get("source", "real"), segments=list(clip.phones or []))
 
 
 @dataclass

@@ -18,6 +18,7 @@ import torch
 
 from ..corpus.pose import apply_pose as apply_pose_np
 from ..data.datasets import open_dataset
+from . import articulation as art
 from .data import prepare
 from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
@@ -27,16 +28,30 @@ def evaluate(model, ds, split: str = "test", progress=None) -> dict:
     model.eval()
     t = ds.template
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
-    per_clip = []
+    per_clip, artic = [], []
+    D = model.cfg.content_classes
+    confusion = {"all": np.zeros((D, D), np.int64), "human": np.zeros((D, D), np.int64)}
+    heard = {"all": [0, 0], "human": [0, 0]}
     keys = ds.keys(split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
-        out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
+        mel = torch.from_numpy(c.mel)
+        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames)
         pred_unposed, pred_pose = out["unposed"].numpy(), out["pose"].numpy()
         gt_posed = apply_pose_np(c.vertices, c.pose)
         m = clip_metrics(c.vertices, pred_unposed, gt_posed, out["vertices"].numpy(), c.template, c.pose, pred_pose, regions)
         m.update(key=key, source=c.source, frames=c.num_frames)
         per_clip.append(m)
+        a = art.clip_articulation(art.inner_lip_gap(c.vertices, t), art.inner_lip_gap(pred_unposed, t), c.segments, ds.fps)
+        artic.append(a | {"source": c.source})
+        with torch.no_grad():
+            logits = model.content(mel[None])[0].numpy()                      # (Kc, D)
+        labels = c.phones[:: model.cfg.content_stride]
+        for group in ("all", "human") if c.source == "human" else ("all",):
+            confusion[group] += art.content_counts(logits, labels, D)
+            h, n = art.bilabial_heard(logits, labels)
+            heard[group][0] += h
+            heard[group][1] += n
         if progress:
             progress(i + 1, len(keys))
     names = [k for k in per_clip[0] if k not in ("key", "source", "frames")]
@@ -48,9 +63,14 @@ def evaluate(model, ds, split: str = "test", progress=None) -> dict:
         w = np.array([r["frames"] for r in rows], dtype=np.float64)
         return {n: float(np.average([r[n] for r in rows], weights=w if n.startswith("E_") or n.startswith("pose_error") else None))
                 for n in names} | {"clips": len(rows)}
+    human = [r for r in artic if r["source"] == "human"]
+    articulation = {"all": art.summarise(artic), "synthetic": art.summarise([r for r in artic if r["source"] != "human"]),
+                    "human": art.summarise(human)}
+    content = {"all": art.content_summary(confusion["all"], heard["all"]),
+               "human": art.content_summary(confusion["human"], heard["human"]) if human else None}
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
             "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t),
-            "per_clip": per_clip}
+            "articulation": articulation, "content_encoder": content, "per_clip": per_clip}
 
 
 def silence_probe(model, template) -> dict:
@@ -86,6 +106,12 @@ def main(argv=None) -> int:
     print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
           f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
           + (f"  | human E_vl {res['human']['E_vl']:.3f} mm" if res["human"] else ""))
+    ar, ce = res["articulation"]["all"], res["content_encoder"]["all"]
+    print(f"/p b m/ closed {100 * ar['pred_closure']:.1f}% (truth {100 * ar['true_closure']:.1f}%, chance "
+          f"{100 * ar['chance_closure']:.1f}%), closed elsewhere {100 * ar['pred_false_closure']:.1f}% "
+          f"(truth {100 * ar['true_false_closure']:.1f}%), open vowels opened {100 * ar['pred_open_vowel_opened']:.1f}%, "
+          f"gap correlation {ar['gap_corr']:.2f}; content encoder frame accuracy {100 * ce['frame_accuracy']:.1f}%, "
+          f"/p b m/ heard {100 * ce['bilabial_segments_heard']:.1f}%")
     if args.out:
         out = Path(args.out)
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -125,6 +151,7 @@ def markdown(res: dict, args, ck: dict) -> str:
         f"{res['silence']['lip_gap_max_mm']:.2f} (0 = touching, below 0 pressed together; the neutral template: "
         f"{res['silence']['neutral_template_gap_mm']:.2f}).",
         "",
+        *art.markdown(res),
     ])
 
 

@@ -1,0 +1,191 @@
+"""Measures of articulation that an average face cannot satisfy (issue 14).
+
+E_vl (a mean of per-frame maxima) rewards a mouth that hovers half open. A viewer judges a talking face by
+whether the lips close on /p b m/ and open on open vowels, so these count segments, not millimetres:
+
+- bilabial closure (hit rate): /p b m/ segments in which the inner lips close (gap < CLOSED_MM) at some frame;
+- false alarms: other speech segments in which they close (the same criterion), so a flapping mouth cannot score;
+- chance: the hit rate of the same predicted gap shifted in time against the phones (a mouth that closes often
+  but at the wrong moments scores high here too, and only the distance from chance is evidence of timing);
+- open-vowel opening: open-vowel segments in which the gap exceeds OPEN_MM at some frame;
+- gap correlation with the truth over time, and the lip amplitude ratio (predicted / true lip motion);
+- the content encoder: frame accuracy against the alignment, per-phone recall, the confusion matrix, and the
+  share of /p b m/ segments it calls bilabial at one or more of their frames.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..corpus.checks import OPEN_VOWELS, contour_gap
+from ..corpus.phonemes import BILABIALS, PHONES, SILENCE
+from ..template import Template
+
+CLOSED_MM = 1.0   # inner lips this close count as closed
+OPEN_MM = 3.0     # and this far apart as open
+CHANCE_SHIFTS = (0.25, 0.5, 0.75)  # circular shifts of the prediction, as fractions of the clip
+MIN_OPEN_VOWEL_S = 0.08  # shorter open vowels are not expected to open fully, even in the truth
+
+
+def inner_lip_gap(unposed_mm: np.ndarray, template: Template) -> np.ndarray:
+    """(F, N, 3) unposed vertices in mm -> (F,) inner-lip gap in mm."""
+    r = template.regions
+    return contour_gap(unposed_mm, r["lips_inner_upper"], r["lips_inner_lower"])
+
+
+def segment_frames(start: float, end: float, fps: float, n_frames: int) -> np.ndarray:
+    """Frames whose time i / fps lies in [start, end) (a frame on a boundary belongs to the later segment);
+    the nearest one to the centre for a segment too short to hold a frame."""
+    eps = 1e-6  # times written to 4 decimals: a boundary on a frame time stays on it
+    k = np.arange(int(np.ceil(start * fps - eps)), int(np.ceil(end * fps - eps)))
+    k = k[(k >= 0) & (k < n_frames)]
+    return k if len(k) else np.array([int(np.clip(round(0.5 * (start + end) * fps), 0, n_frames - 1))])
+
+
+def segment_counts(gap: np.ndarray, phones, fps: float) -> dict:
+    """Counts of (hits, trials) for closure on bilabials, closure elsewhere in speech, and opening on open vowels."""
+    c = {"bilabial_closed": 0, "bilabial": 0, "other_closed": 0, "other": 0, "open_vowel_opened": 0, "open_vowel": 0}
+    for p, a, b in phones:
+        if p == SILENCE:
+            continue
+        g = gap[segment_frames(a, b, fps, len(gap))]
+        if p in BILABIALS:
+            c["bilabial"] += 1
+            c["bilabial_closed"] += int(g.min() < CLOSED_MM)
+        else:
+            c["other"] += 1
+            c["other_closed"] += int(g.min() < CLOSED_MM)
+        if p in OPEN_VOWELS and b - a >= MIN_OPEN_VOWEL_S:
+            c["open_vowel"] += 1
+            c["open_vowel_opened"] += int(g.max() > OPEN_MM)
+    return c
+
+
+def chance_counts(gap: np.ndarray, phones, fps: float) -> dict:
+    """Bilabial closures of the same gap track shifted in time (circularly), summed over CHANCE_SHIFTS."""
+    c = {"bilabial_closed": 0, "bilabial": 0}
+    for s in CHANCE_SHIFTS:
+        shifted = segment_counts(np.roll(gap, int(round(s * len(gap)))), phones, fps)
+        c["bilabial_closed"] += shifted["bilabial_closed"]
+        c["bilabial"] += shifted["bilabial"]
+    return c
+
+
+def clip_articulation(gap_true: np.ndarray, gap_pred: np.ndarray, phones, fps: float) -> dict:
+    """Per-clip counts for the truth and the prediction, the prediction's chance counts, and the gap correlation."""
+    n = min(len(gap_true), len(gap_pred))
+    gt, pr = gap_true[:n], gap_pred[:n]
+    corr = float(np.corrcoef(gt, pr)[0, 1]) if gt.std() > 1e-6 and pr.std() > 1e-6 else 0.0
+    return {"true": segment_counts(gt, phones, fps), "pred": segment_counts(pr, phones, fps),
+            "chance": chance_counts(pr, phones, fps), "gap_corr": corr,
+            "gap_std_true": float(gt.std()), "gap_std_pred": float(pr.std())}
+
+
+def summarise(rows: list[dict]) -> dict | None:
+    """Rates pooled over clips' segments (every segment counts once); correlation averaged over clips."""
+    if not rows:
+        return None
+
+    def total(side: str, key: str) -> int:
+        return sum(r[side][key] for r in rows)
+
+    def rate(side: str, hit: str, n: str) -> float:
+        return total(side, hit) / max(total(side, n), 1)
+    out = {"bilabial_segments": total("true", "bilabial"), "other_segments": total("true", "other"),
+           "open_vowel_segments": total("true", "open_vowel"),
+           "gap_corr": float(np.mean([r["gap_corr"] for r in rows])),
+           "gap_std_ratio": float(np.mean([r["gap_std_pred"] for r in rows]) / max(np.mean([r["gap_std_true"] for r in rows]), 1e-9)),
+           "chance_closure": rate("chance", "bilabial_closed", "bilabial")}
+    for side in ("true", "pred"):
+        out[f"{side}_closure"] = rate(side, "bilabial_closed", "bilabial")
+        out[f"{side}_false_closure"] = rate(side, "other_closed", "other")
+        out[f"{side}_open_vowel_opened"] = rate(side, "open_vowel_opened", "open_vowel")
+    return out
+
+
+# ---- the content encoder ---------------------------------------------------------------------------------
+
+def content_counts(logits: np.ndarray, labels: np.ndarray, num_classes: int) -> np.ndarray:
+    """(Kc, D) logits and (Kc,) phone labels -> (D, D) confusion counts, rows = truth, columns = argmax."""
+    n = min(len(logits), len(labels))
+    conf = np.zeros((num_classes, num_classes), np.int64)
+    np.add.at(conf, (labels[:n], logits[:n].argmax(-1)), 1)
+    return conf
+
+
+def bilabial_heard(logits: np.ndarray, labels: np.ndarray) -> tuple[int, int]:
+    """(segments of /p b m/ with a bilabial argmax at one or more of their frames, segments)."""
+    bil = np.array([PHONES.index(p) for p in BILABIALS])
+    n = min(len(logits), len(labels))
+    is_bil = np.isin(labels[:n], bil)
+    called = np.isin(logits[:n].argmax(-1), bil)
+    hits = segs = 0
+    k = 0
+    while k < n:
+        if not is_bil[k]:
+            k += 1
+            continue
+        j = k
+        while j < n and labels[j] == labels[k]:
+            j += 1
+        segs += 1
+        hits += int(called[k:j].any())
+        k = j
+    return hits, segs
+
+
+def content_summary(conf: np.ndarray, heard: tuple[int, int]) -> dict:
+    """Frame accuracy, per-phone recall (with frame counts), and the bilabial segment detection rate."""
+    support = conf.sum(1)
+    recall = {PHONES[i]: {"recall": float(conf[i, i] / support[i]), "frames": int(support[i]),
+                          "mistaken_for": [PHONES[j] if j < len(PHONES) else "blank"
+                                           for j in np.argsort(-conf[i])[:4] if j != i and conf[i, j] > 0][:3]}
+              for i in range(len(PHONES)) if support[i] > 0}
+    speech = [i for i in range(len(PHONES)) if PHONES[i] != SILENCE]
+    return {"frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
+            "speech_frame_accuracy": float(np.diag(conf)[speech].sum() / max(conf[speech].sum(), 1)),
+            "bilabial_segments_heard": heard[0] / max(heard[1], 1), "bilabial_segments": heard[1],
+            "recall": recall, "confusion": conf.tolist()}
+
+
+def markdown(res: dict) -> list[str]:
+    """The articulation and content-encoder tables of docs/results/<model>.md."""
+    pct = lambda x: f"{100 * x:.1f}%"
+    rows = []
+    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+        a, m = res["articulation"][name], res[name]
+        if a:
+            rows.append(f"| {label} | {a['bilabial_segments']} | {pct(a['true_closure'])} / **{pct(a['pred_closure'])}** / "
+                        f"{pct(a['chance_closure'])} | {pct(a['true_false_closure'])} / {pct(a['pred_false_closure'])} | "
+                        f"{pct(a['true_open_vowel_opened'])} / {pct(a['pred_open_vowel_opened'])} | {a['gap_corr']:.2f} | "
+                        f"{a['gap_std_ratio']:.2f} | {m['lip_motion_pred'] / m['lip_motion_gt']:.2f} |")
+    crow = []
+    for name, label in (("all", "all test clips"), ("human", "recorded human speech")):
+        c = res["content_encoder"][name]
+        if c:
+            rec = lambda p: pct(c["recall"][p]["recall"]) if p in c["recall"] else "-"
+            crow.append(f"| {label} | {pct(c['frame_accuracy'])} | {pct(c['speech_frame_accuracy'])} | "
+                        f"{pct(c['bilabial_segments_heard'])} of {c['bilabial_segments']} | "
+                        + " / ".join(rec(p) for p in ("P", "B", "M", "F", "V")) + " |")
+    return [
+        "## Articulation",
+        "",
+        f"Segments of the alignment. Closed: the inner-lip gap below {CLOSED_MM:g} mm at some frame of the segment; opened: above",
+        f"{OPEN_MM:g} mm (open vowels of {MIN_OPEN_VOWEL_S * 1000:.0f} ms or more). Chance: the model's own gap track shifted in time by",
+        f"{', '.join(f'{s:g}' for s in CHANCE_SHIFTS)} of the clip against the phones. False closures: other speech segments",
+        "in which the lips close (the truth closes some: neighbours of /p b m/ share their closure). Gap correlation: Pearson",
+        "over time per clip, averaged; gap std ratio and lip amplitude ratio: predicted / true.",
+        "",
+        "| clips | /p b m/ | /p b m/ closed: truth / **model** / chance | closed in other speech: truth / model | open vowels opened: truth / model | gap correlation | gap std ratio | lip amplitude ratio |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        *rows,
+        "",
+        "## The content encoder (the stand-in for DeepSpeech)",
+        "",
+        "Argmax of its logits against the alignment, frame by frame (50 per second). Bilabial segments heard: /p b m/",
+        "segments called P, B or M at one or more of their frames.",
+        "",
+        "| clips | frame accuracy | speech frames | /p b m/ segments heard | recall P / B / M / F / V |",
+        "| --- | --- | --- | --- | --- |",
+        *crow,
+        "",
+    ]
