@@ -78,8 +78,15 @@ export interface StageTimes {
   posing: number;
 }
 
-/** Mel frames of context around a chunk: more than the convolutions' reach (manifest.receptive_field). */
+/** Mel frames of context around a chunk: at least the convolutions' reach (manifest.receptive_field). */
 const MEL_CONTEXT = 16;
+
+/** Mel frames of context before a chunk's first content frame: the content encoder's look-back, at least
+ * MEL_CONTEXT, rounded up to a whole content frame so the strided convolution lines up with the whole clip. */
+function contentContextBack(manifest: Manifest): number {
+  const stride = manifest.model.config.content_stride;
+  return Math.ceil(Math.max(MEL_CONTEXT, manifest.receptive_field.content_mel_frames_back) / stride) * stride;
+}
 
 /** Frames of one chunk: posed vertices and I + O in the template's units, poses (axis-angle, mm). */
 export interface Frames {
@@ -309,7 +316,7 @@ export class TalkingFaceEngine {
     // Content frames the windows need, and the Mel frames (with context) that produce them.
     const cLo = Math.max(0, Math.floor(melIndex[0] / m.content_stride) - (m.window - 1 - m.window_future));
     const cHi = Math.min(Kc, Math.floor(melIndex[melIndex.length - 1] / m.content_stride) + m.window_future + 1);
-    const melLo = Math.max(0, cLo * m.content_stride - MEL_CONTEXT);
+    const melLo = Math.max(0, cLo * m.content_stride - contentContextBack(this.manifest));
     const melHi = Math.min(K, Math.max(cHi * m.content_stride, melIndex[melIndex.length - 1] + 1) + MEL_CONTEXT);
     const signalEnd = Number.isFinite(total) ? total : offset + samples.length;
     let t = performance.now();
@@ -598,10 +605,11 @@ export class StreamSession {
     if (this.latencies.length > 300) this.latencies.splice(0, this.latencies.length - 300);
   }
 
-  /** Forget audio no future frame can read (its receptive field starts at most ~48 Mel frames back). */
+  /** Forget audio no future frame can read: its content window's first frame, less the encoder's look-back. */
   private trim(): void {
-    const a = this.engine.manifest.audio;
-    const keepFrom = Math.max(0, (frameToMelIndex(this.next, a) - 48) * a.hop - a.frame_size);
+    const { audio: a, model } = this.engine.manifest;
+    const back = (model.config.window - model.config.window_future) * model.config.content_stride + contentContextBack(this.engine.manifest);
+    const keepFrom = Math.max(0, (frameToMelIndex(this.next, a) - back) * a.hop - a.frame_size);
     if (keepFrom - this.offset > this.buffer.length / 2) {
       const drop = keepFrom - this.offset;
       this.buffer.copyWithin(0, drop, this.received - this.offset);

@@ -90,23 +90,27 @@ def decoder_tensors(model: TalkingFace) -> dict[str, np.ndarray]:
 
 
 def receptive_field(model: TalkingFace) -> dict:
-    """How many Mel frames past its own position each encoder output reads (the streaming look-ahead):
-    measured, not assumed, by perturbing one Mel frame (at both stride parities) and seeing which outputs move."""
+    """How many Mel frames past its own position each encoder output reads (the streaming look-ahead), and how
+    many before it (the context a chunk must carry): measured, not assumed, by perturbing one Mel frame (at both
+    stride parities) and seeing which outputs move."""
     cfg = model.cfg
-    K = 200
-    content_reach, pose_reach = 0, 0
+    K = 300
+    reach = {"content_mel_frames": 0, "pose_mel_frames": 0, "content_mel_frames_back": 0, "pose_mel_frames_back": 0}
     with torch.no_grad():
         mel = torch.randn(1, K, model.audio.n_mels)
         base_c = model.content(mel)
         base_p = model.pose_encoder.conv(model.pose_encoder.norm(mel).transpose(1, 2))
-        for probe in (60, 61):
+        for probe in (150, 151):
             moved = mel.clone()
             moved[0, probe] += 1.0
-            c = (model.content(moved) - base_c).abs().amax(-1)[0]
-            p = (model.pose_encoder.conv(model.pose_encoder.norm(moved).transpose(1, 2)) - base_p).abs().amax(1)[0]
-            content_reach = max(content_reach, probe - int(torch.nonzero(c > 0)[0]) * cfg.content_stride)
-            pose_reach = max(pose_reach, probe - int(torch.nonzero(p > 0)[0]))
-    return {"content_mel_frames": content_reach, "pose_mel_frames": pose_reach}
+            c = torch.nonzero((model.content(moved) - base_c).abs().amax(-1)[0] > 0).flatten()
+            p = torch.nonzero((model.pose_encoder.conv(model.pose_encoder.norm(moved).transpose(1, 2)) - base_p).abs().amax(1)[0] > 0).flatten()
+            # Content frame j covers Mel frames [j * stride, (j + 1) * stride).
+            reach["content_mel_frames"] = max(reach["content_mel_frames"], probe - int(c[0]) * cfg.content_stride)
+            reach["content_mel_frames_back"] = max(reach["content_mel_frames_back"], (int(c[-1]) + 1) * cfg.content_stride - 1 - probe)
+            reach["pose_mel_frames"] = max(reach["pose_mel_frames"], probe - int(p[0]))
+            reach["pose_mel_frames_back"] = max(reach["pose_mel_frames_back"], int(p[-1]) - probe)
+    return reach
 
 
 FIXTURE_SECONDS = 0.6     # a short clip keeps the fixtures small

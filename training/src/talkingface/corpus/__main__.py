@@ -1,6 +1,6 @@
 """Command line for the synthetic corpus.
 
-  scripts/py -m talkingface.corpus setup                     install the Debian speech tools (apt)
+  scripts/py -m talkingface.corpus setup [--kokoro]          install the Debian speech tools (apt) [and Kokoro's voices]
   scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
   scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
   scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
@@ -38,7 +38,11 @@ def _progress():
     return report
 
 
-def cmd_setup(_args) -> int:
+def cmd_setup(args) -> int:
+    if args.kokoro:  # the speech front-end's natural voices (python -m talkingface.frontend.speechset)
+        from . import kokoro
+        print(f"kokoro: {len(kokoro.voice_names()) if kokoro.available() else 0} voices in {kokoro.setup()}: "
+              f"{len(kokoro.voice_names())} English voices")
     missing = [p for p in DEBIAN_PACKAGES if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
     if not missing:
         print("speech tools: all installed")
@@ -85,7 +89,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.corpus", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
-    sub.add_parser("setup", help="install the Debian packages the corpus needs").set_defaults(fn=cmd_setup)
+    st = sub.add_parser("setup", help="install the Debian packages the corpus needs")
+    st.add_argument("--kokoro", action="store_true", help="also fetch the Kokoro voices (hash-pinned) for the speech front-end")
+    st.set_defaults(fn=cmd_setup)
     b = sub.add_parser("build", help="build a corpus")
     b.add_argument("--preset", choices=sorted(PRESETS), default="small")
     b.add_argument("--out", required=True, help="output folder (must be empty or a corpus to --overwrite)")

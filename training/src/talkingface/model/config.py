@@ -6,6 +6,10 @@ from dataclasses import asdict, dataclass, fields
 from ..corpus.phonemes import PHONES
 
 
+# Values that fields added later had implicitly before they existed (what an older checkpoint means).
+LEGACY = {"content_arch": "conv4"}
+
+
 @dataclass(frozen=True)
 class ModelConfig:
     features: str = "LG"          # hierarchical feature: "G" global only, "L" local only, "LG" both summed (Sec. III-C)
@@ -16,6 +20,8 @@ class ModelConfig:
     layers: int = 3               # attention layers (the paper's Fig. 7 reads the third)
     ffn: int = 64                 # feed-forward hidden size
     content_classes: int = len(PHONES) + 1  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
+    content_arch: str = "dilated" # "dilated": residual dilated convolutions reading 550 ms back, 70 ms ahead (issue 14);
+                                  # "conv4": the first encoder, four convolutions reading 70 ms each way
     content_channels: int = 128   # content encoder width
     window: int = 16              # W: content frames per animation frame (paper: 16)
     window_future: int = 1        # of which after the frame: 1 x 20 ms + the encoder reach (70 ms) + half a Mel frame = 106 ms look-ahead
@@ -32,6 +38,7 @@ class ModelConfig:
     @classmethod
     def from_dict(cls, d: dict) -> "ModelConfig":
         names = {f.name for f in fields(cls)}
+        d = LEGACY | d  # a checkpoint written before a field existed was made with the field's old behaviour
         unknown = set(d) - names
         if unknown:
             raise ValueError(f"unknown model config keys {sorted(unknown)}: checkpoint from a newer version?")

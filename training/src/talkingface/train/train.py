@@ -68,6 +68,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--paper-loss", action="store_true", help="the paper's Eq. 3 exactly (no unposed or lip reconstruction terms; see losses.py)")
     ap.add_argument("--silence", type=float, default=0.2,
                     help="chance that a crop is pure silence with the rest face as target (data.py); 0 = the paper's data")
+    ap.add_argument("--frontend", help="a speech front-end trained on its own (talkingface.frontend.train: OUT/frontend.pt): "
+                    "its content encoder replaces the model's and stays frozen")
+    ap.add_argument("--tune-frontend", action="store_true", help="with --frontend: fine-tune it with the face instead of freezing it")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -90,7 +93,10 @@ def main(argv=None) -> int:
 
     ds = open_dataset(args.corpus, args.template, args.masks)
     audio = AudioConfig(fps=int(ds.fps))
-    cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant)
+    frontend = torch.load(args.frontend, map_location="cpu", weights_only=False) if args.frontend else None
+    content_cfg = {k: frontend["model_config"][k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")} \
+        if frontend else {}
+    cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant, **content_cfg)
     t0 = time.time()
     clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
@@ -104,10 +110,14 @@ def main(argv=None) -> int:
     torch.manual_seed(args.seed)
     model = TalkingFace(cfg, ds.template, audio)
     mean, std = mel_statistics(clips)
-    for norm in (model.content.norm, model.pose_encoder.norm):
+    for norm in (model.pose_encoder.norm,) if frontend else (model.content.norm, model.pose_encoder.norm):
         norm.mean.copy_(torch.from_numpy(mean))
         norm.std.copy_(torch.from_numpy(std))
-    opt = torch.optim.Adam(model.parameters(), lr=args.lr)
+    if frontend:  # its own Mel normalisation (statistics of its far larger speech set) comes with it
+        model.content.load_state_dict(frontend["content"])
+        model.content.requires_grad_(args.tune_frontend)
+        log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
+    opt = torch.optim.Adam([p for p in model.parameters() if p.requires_grad], lr=args.lr)
     step, trained_seconds = 0, 0.0
     ck_path = out / "checkpoint.pt"
     if args.resume:

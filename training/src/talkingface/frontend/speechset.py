@@ -1,0 +1,183 @@
+"""The speech front-end's own training speech: every voice the project can get, no meshes.
+
+The content encoder (our DeepSpeech stand-in) learns phones from log-Mel. The mesh corpus has 35 minutes of
+speech from a few dozen voices; phone recognition is limited by how many voices it has heard (issue 14), so the
+front-end trains apart from the face, on this set:
+
+- Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds;
+- festival, flite and espeak-ng voices (corpus/speech.py);
+- the recorded human speech of the corpus's train split (one speaker, real microphones).
+
+Phone labels: the synthesiser's own timings (festival, flite) or pocketsphinx forced alignment (the rest).
+Each clip gets the corpus's augmentation (tempo, pitch, microphone, room, noise, band, level) with
+probability AUGMENT_SHARE. The face corpus's test voices, test sentences and test recordings never occur here,
+so its test split measures the front-end on held-out voices.
+
+Output: one .npz per clip (log-Mel as float16, a phone class per Mel frame) and an index.jsonl.
+  scripts/py -m talkingface.frontend.speechset --out data/speech --minutes 120 --workers 2
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import sys
+import time
+from dataclasses import asdict, dataclass
+from multiprocessing import get_context
+from pathlib import Path
+
+import numpy as np
+
+from ..corpus import kokoro, recorded
+from ..corpus.align import AlignmentError, Aligner
+from ..corpus.augment import augment_channel, augment_speech
+from ..corpus.build import PRESETS, _split_of_recording, is_test_voice
+from ..corpus.phonemes import PHONE_INDEX, SILENCE
+from ..corpus.sentences import generate_sentences
+from ..corpus.speech import Voice, all_voices, fit_to_duration, resample, synthesize
+from ..data.datasets import read_wav
+from ..features import AudioConfig, log_mel
+
+AUGMENT_SHARE = 0.7
+SHARES = {"kokoro": 0.6, "classic": 0.25, "human": 0.15}  # of the clips; the human share is capped by the recordings
+
+
+@dataclass
+class SpeechSpec:
+    key: str
+    engine: str          # "kokoro", "festival", "flite", "espeak" or "human"
+    voice: str           # voice name, a Kokoro blend "a*0.7+b", or the recording's name
+    text: str
+    speed: float
+    seed: int
+
+
+def face_test_sentences(seed: int = 0) -> set[str]:
+    """The mesh corpus's val and test sentences (full preset): the front-end never trains on them."""
+    cfg = PRESETS["full"]
+    pools = generate_sentences(sum(cfg.sentence_pool), seed + 1)
+    return set(pools[cfg.sentence_pool[0]:])
+
+
+def texts(n: int, seed: int) -> list[str]:
+    """Sentences from the corpus's grammar (another seed) and the recordings' train-split transcripts."""
+    banned = face_test_sentences()
+    out = [s for s in generate_sentences(n + len(banned), seed + 1000) if s not in banned][:n]
+    if recorded.available():
+        out += [r.text for r in recorded.recordings() if _split_of_recording(r.name) == "train"]
+    return out
+
+
+def plan(minutes: float, seed: int) -> list[SpeechSpec]:
+    rng = np.random.default_rng(seed)
+    n = int(minutes * 60 / 3.0)  # clips average about 3 s
+    pool = texts(max(n, 400), seed)
+    k_voices = kokoro.voice_names()
+    if not k_voices:
+        raise kokoro.KokoroMissing("Kokoro is not set up: run `scripts/py -m talkingface.corpus setup --kokoro`")
+    classic = [v for v in all_voices() if not is_test_voice(v)]
+    humans = [r for r in recorded.recordings() if _split_of_recording(r.name) == "train"] if recorded.available() else []
+    specs = []
+    for i in range(n):
+        key = f"s{i:05d}"
+        clip_seed = int.from_bytes(hashlib.sha256(f"{seed}:{key}".encode()).digest()[:4], "little")
+        r = rng.random()
+        text = pool[rng.integers(len(pool))]
+        if r < SHARES["human"] and humans:
+            h = humans[rng.integers(len(humans))]
+            specs.append(SpeechSpec(key, "human", h.name, h.text, 1.0, clip_seed))
+        elif r < SHARES["human"] + SHARES["classic"]:
+            v = classic[rng.integers(len(classic))]
+            specs.append(SpeechSpec(key, v.engine, v.name, text, 1.0, clip_seed))
+        else:
+            a = k_voices[rng.integers(len(k_voices))]
+            if rng.random() < 0.3:  # a voice between two voices
+                b = k_voices[rng.integers(len(k_voices))]
+                a = f"{a}*{rng.uniform(0.3, 0.7):.2f}+{b}" if b != a else a
+            specs.append(SpeechSpec(key, "kokoro", a, text, float(rng.uniform(0.85, 1.2)), clip_seed))
+    return specs
+
+
+def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
+    """Audio at sr and its phones (synthesiser timings or forced alignment)."""
+    if spec.engine == "human":
+        rec = next(r for r in recorded.recordings() if r.name == spec.voice)
+        audio, rate = read_wav(rec.path)
+        audio = resample(audio, rate, sr)
+        phones = None
+    elif spec.engine == "kokoro":
+        audio = resample(kokoro.synthesize(spec.voice, spec.text, spec.speed), kokoro.KOKORO_RATE, sr)
+        audio = np.concatenate([np.zeros(int(0.2 * sr), np.float32), audio, np.zeros(int(0.2 * sr), np.float32)])
+        phones = None
+    else:
+        audio, phones = synthesize(Voice(spec.engine, spec.voice), spec.text, sr)
+    if phones is None:
+        phones, _ = Aligner().align(audio, sr, spec.text)  # a fresh decoder per clip: no state between clips
+    return audio, phones
+
+
+def frame_labels(phones, n_frames: int, feature_rate: float) -> np.ndarray:
+    lab = np.full(n_frames, PHONE_INDEX[SILENCE], np.int8)
+    for p, a, b in phones:
+        lab[int(round(a * feature_rate)): int(round(b * feature_rate))] = PHONE_INDEX[p]
+    return lab
+
+
+def build_one(args) -> dict:
+    spec, out = args
+    audio_cfg = AudioConfig()
+    rng = np.random.default_rng(spec.seed)
+    try:
+        audio, phones = speak(spec, audio_cfg.sample_rate)
+    except (AlignmentError, RuntimeError) as e:  # recorded as skipped with its reason; the set goes on
+        return asdict(spec) | {"skipped": f"{type(e).__name__}: {e}"}
+    strength = 1.0 if rng.random() < AUGMENT_SHARE else 0.0
+    audio, phones, a1 = augment_speech(audio, audio_cfg.sample_rate, phones, rng, strength)
+    phones = fit_to_duration(phones, len(audio) / audio_cfg.sample_rate)
+    audio, a2 = augment_channel(audio, audio_cfg.sample_rate, rng, strength)
+    mel = log_mel(audio, audio_cfg)
+    labels = frame_labels(phones, len(mel), audio_cfg.feature_rate)
+    np.savez(Path(out) / f"{spec.key}.npz", mel=mel.astype(np.float16), labels=labels)
+    return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2}
+
+
+def build(out: Path, minutes: float, seed: int, workers: int) -> dict:
+    out.mkdir(parents=True, exist_ok=True)
+    specs = plan(minutes, seed)
+    done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
+    todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
+    t0, n = time.time(), 0
+    print(f"speech set: {len(specs)} clips planned, {len(todo)} to build, {workers} workers -> {out}", file=sys.stderr)
+    with get_context("fork").Pool(workers) as pool, open(out / "index.jsonl", "a") as index:
+        for rec in pool.imap_unordered(build_one, [(s, str(out)) for s in todo], chunksize=2):
+            index.write(json.dumps(rec) + "\n")
+            index.flush()
+            n += 1
+            if n % 50 == 0 or n == len(todo):
+                el = time.time() - t0
+                print(f"  {n}/{len(todo)} clips, {el:.0f} s, ~{el / n * (len(todo) - n):.0f} s left", file=sys.stderr, flush=True)
+    rows = [json.loads(l) for l in (out / "index.jsonl").read_text().splitlines()]
+    ok = [r for r in rows if "skipped" not in r]
+    meta = {"clips": len(ok), "skipped": len(rows) - len(ok), "minutes": round(sum(r["seconds"] for r in ok) / 60, 1),
+            "seed": seed, "voices": len({r["voice"] for r in ok}),
+            "by_engine": {e: sum(r["engine"] == e for r in ok) for e in sorted({r["engine"] for r in ok})}}
+    (out / "meta.json").write_text(json.dumps(meta, indent=1))
+    return meta
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.speechset", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--minutes", type=float, default=120.0, help="planned speech (before skips), minutes")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--workers", type=int, default=2)
+    args = ap.parse_args(argv)
+    meta = build(args.out, args.minutes, args.seed, args.workers)
+    print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,200 @@
+"""Train the speech front-end (the content encoder) on its own, before and apart from the face.
+
+  scripts/py -m talkingface.frontend.train --speech data/speech --corpus data/corpus --out runs/frontend --minutes 30
+
+Frame-wise cross-entropy against the phone labels of the speech set (speechset.py), on random 3 s crops with
+frequency warping (vocal-tract length, 0.9-1.1) and SpecAugment-style masks. Every --eval-every steps it is
+measured on the mesh corpus's val and test splits, whose voices, sentences and recordings it never trains on.
+OUT/frontend.pt carries the encoder's weights (its Mel normalisation included), the model config, and the
+evaluation; `talkingface.train.train --frontend OUT/frontend.pt` puts it into the face model, frozen.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+from ..data.datasets import open_dataset
+from ..features import AudioConfig
+from ..model.config import ModelConfig
+from ..model.encoders import ContentEncoder
+from ..train import articulation as art
+from ..train.data import prepare
+
+CROP = 300           # Mel frames per crop (3 s)
+WARP = (0.9, 1.1)    # frequency-axis warp factors (vocal-tract length perturbation)
+TIME_MASKS, TIME_MASK_MAX = 2, 12   # SpecAugment: masks per crop and their largest width (Mel frames)
+FREQ_MASKS, FREQ_MASK_MAX = 2, 10   # and along the Mel bands
+
+
+def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
+    rows = [json.loads(l) for l in (folder / "index.jsonl").read_text().splitlines()]
+    out = []
+    for r in rows:
+        if "skipped" in r:
+            continue
+        z = np.load(folder / f"{r['key']}.npz")
+        out.append((z["mel"].astype(np.float32), z["labels"].astype(np.int64)))
+    if not out:
+        raise SystemExit(f"no clips in {folder}: build it with python -m talkingface.frontend.speechset")
+    return out
+
+
+def warp(mel: np.ndarray, factor: float) -> np.ndarray:
+    """Stretch the Mel axis by `factor` (> 1: a shorter vocal tract, formants move up), edge values held."""
+    n = mel.shape[1]
+    src = np.clip(np.arange(n) / factor, 0, n - 1)
+    lo = np.floor(src).astype(int)
+    hi = np.minimum(lo + 1, n - 1)
+    w = src - lo
+    return mel[:, lo] * (1 - w) + mel[:, hi] * w
+
+
+def batch(clips, rng, size: int, stride: int) -> tuple[torch.Tensor, torch.Tensor]:
+    mels, labs = np.zeros((size, CROP, clips[0][0].shape[1]), np.float32), np.full((size, -(-CROP // stride)), -100, np.int64)
+    for b in range(size):
+        mel, lab = clips[rng.integers(len(clips))]
+        k0 = rng.integers(max(1, len(mel) - CROP + 1))
+        m = warp(mel[k0:k0 + CROP], rng.uniform(*WARP))
+        mels[b, : len(m)] = m
+        l = lab[k0:k0 + CROP:stride]
+        labs[b, : len(l)] = l
+    return torch.from_numpy(mels), torch.from_numpy(labs)
+
+
+def spec_augment(x: torch.Tensor, rng) -> torch.Tensor:
+    """Masks on the normalised features (0 = the mean), so the encoder cannot lean on any one band or instant."""
+    B, K, M = x.shape
+    x = x.clone()
+    for b in range(B):
+        for _ in range(TIME_MASKS):
+            w = rng.integers(TIME_MASK_MAX + 1)
+            t = rng.integers(max(1, K - w))
+            x[b, t:t + w] = 0
+        for _ in range(FREQ_MASKS):
+            w = rng.integers(FREQ_MASK_MAX + 1)
+            f = rng.integers(max(1, M - w))
+            x[b, :, f:f + w] = 0
+    return x
+
+
+def forward_augmented(enc: ContentEncoder, mel: torch.Tensor, rng) -> torch.Tensor:
+    """The encoder's forward with SpecAugment between its normalisation and its convolutions."""
+    x = spec_augment(enc.norm(mel), rng)
+    identity = enc.norm
+    enc.norm = torch.nn.Identity()
+    try:
+        return enc(x)
+    finally:
+        enc.norm = identity
+
+
+@torch.no_grad()
+def evaluate(enc: ContentEncoder, clips, num_classes: int, stride: int) -> dict:
+    enc.eval()
+    conf = np.zeros((num_classes, num_classes), np.int64)
+    heard = [0, 0]
+    for c in clips:
+        logits = enc(torch.from_numpy(c.mel)[None])[0].numpy()
+        labels = c.phones[::stride]
+        conf += art.content_counts(logits, labels, num_classes)
+        h, n = art.bilabial_heard(logits, labels)
+        heard[0] += h
+        heard[1] += n
+    enc.train()
+    return art.content_summary(conf, tuple(heard))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.train", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--speech", type=Path, required=True, help="speech set folder (talkingface.frontend.speechset)")
+    ap.add_argument("--corpus", type=Path, required=True, help="mesh corpus whose val/test splits measure it")
+    ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument("--minutes", type=float, default=30.0)
+    ap.add_argument("--batch", type=int, default=16)
+    ap.add_argument("--lr", type=float, default=2e-3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--threads", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--eval-every", type=int, default=500)
+    ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    args = ap.parse_args(argv)
+    torch.set_num_threads(args.threads)
+    torch.manual_seed(args.seed)
+    rng = np.random.default_rng(args.seed)
+    args.out.mkdir(parents=True, exist_ok=True)
+    log = lambda *a: print(*a, file=sys.stderr, flush=True)
+
+    cfg, audio = ModelConfig(), AudioConfig()
+    clips = load_speech(args.speech)
+    ds = open_dataset(args.corpus)
+    held = {split: [prepare(ds, k, audio) for k in ds.keys(split)] for split in ("val", "test")}
+    log(f"front-end: {len(clips)} clips, {sum(len(m) for m, _ in clips) / audio.feature_rate / 60:.1f} min of speech; "
+        f"measured on {len(held['val'])} val / {len(held['test'])} test clips of {args.corpus}")
+
+    enc = ContentEncoder(cfg, audio.n_mels)
+    allmel = np.concatenate([m for m, _ in clips])
+    enc.norm.mean.copy_(torch.from_numpy(allmel.mean(0)))
+    enc.norm.std.copy_(torch.from_numpy(allmel.std(0) + 1e-3))
+    del allmel
+    opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)
+    step, trained, history = 0, 0.0, []
+    ck_path = args.out / "checkpoint.pt"
+    if args.resume:
+        ck = torch.load(ck_path, map_location="cpu", weights_only=False)
+        enc.load_state_dict(ck["content"])
+        opt.load_state_dict(ck["optimizer"])
+        step, trained, history = ck["step"], ck["trained_seconds"], ck["history"]
+        log(f"resumed at step {step} ({trained / 60:.1f} min)")
+
+    def save(path: Path, final: bool = False) -> None:
+        payload = {"content": enc.state_dict(), "optimizer": opt.state_dict(), "step": step, "trained_seconds": trained,
+                   "history": history, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(), "args": vars(args) | {
+                       "speech": str(args.speech), "corpus": str(args.corpus), "out": str(args.out)}}
+        if final:
+            payload.pop("optimizer")
+        torch.save(payload, path.with_suffix(".tmp"))
+        os.replace(path.with_suffix(".tmp"), path)
+
+    start = time.time() - trained
+    losses = []
+    while (trained := time.time() - start) < 60 * args.minutes:
+        for g in opt.param_groups:  # cosine over the time budget
+            g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(trained / (60 * args.minutes), 1.0))))
+        mel, lab = batch(clips, rng, args.batch, cfg.content_stride)
+        logits = forward_augmented(enc, mel, rng)
+        k = min(logits.shape[1], lab.shape[1])
+        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), ignore_index=-100)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
+        opt.step()
+        step += 1
+        losses.append(loss.item())
+        if step % args.eval_every == 0:
+            ev = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
+            history.append({"step": step, "minutes": trained / 60, "loss": float(np.mean(losses[-100:])),
+                            **{f"{s}_{m}": ev[s][m] for s in ev for m in ("frame_accuracy", "bilabial_segments_heard")}})
+            log(f"step {step}  loss {history[-1]['loss']:.3f}  val acc {100 * ev['val']['frame_accuracy']:.1f}%  "
+                f"test acc {100 * ev['test']['frame_accuracy']:.1f}%  /p b m/ heard {100 * ev['test']['bilabial_segments_heard']:.1f}%  "
+                f"{step / max(trained, 1e-9):.2f} steps/s  ~{(60 * args.minutes - trained) / 60:.1f} min left")
+            save(ck_path)
+    final = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
+    save(ck_path)
+    save(args.out / "frontend.pt", final=True)
+    (args.out / "frontend_eval.json").write_text(json.dumps({"step": step, "minutes": trained / 60, "history": history,
+                                                             "final": final}, indent=1))
+    log(f"done: {step} steps, test frame accuracy {100 * final['test']['frame_accuracy']:.1f}%, "
+        f"/p b m/ heard {100 * final['test']['bilabial_segments_heard']:.1f}% -> {args.out / 'frontend.pt'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
