@@ -138,6 +138,9 @@ def test_losses_vanish_on_a_perfect_prediction():
     out["unposed"][..., 12, :] += torch.tensor([0.0, 2.0, 0.0])  # an error on one lip vertex: 2 mm / 4 lip vertices
     _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), eye, lips)
     assert parts["rec_lips"] == pytest.approx(0.5, abs=1e-5) and parts["rec_unposed"] == pytest.approx(0.1, abs=1e-5)
+    pairs = torch.tensor([[12, 13], [11, 10]])  # the raised vertex 12 opens the first pair by 2 mm: mean |error| 1 mm
+    _, parts = losses.total_loss(out, v, pose, tpl, torch.full((2, 4), -100), eye, lips, lip_pairs=pairs)
+    assert parts["gap"] == pytest.approx(1.0, abs=1e-5)
 
 
 def test_metrics_on_known_errors(template):

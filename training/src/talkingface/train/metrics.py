@@ -32,6 +32,16 @@ def lip_region(t: Template) -> np.ndarray:
     return np.array(sorted(seen))
 
 
+def inner_lip_pairs(t: Template) -> np.ndarray:
+    """(P, 2) facing (upper, lower) inner-lip vertices: each upper vertex away from the shared mouth corners,
+    with the lower-contour vertex nearest to it across the mouth (in x) on the template."""
+    r = t.regions
+    upper = np.setdiff1d(r["lips_inner_upper"], r["lips_inner_lower"])
+    lower = np.setdiff1d(r["lips_inner_lower"], r["lips_inner_upper"])
+    x = t.vertices[:, 0]
+    return np.array([[u, lower[np.argmin(np.abs(x[lower] - x[u]))]] for u in upper], dtype=np.int64)
+
+
 def eye_region(t: Template) -> np.ndarray:
     r = t.regions
     return np.unique(np.concatenate([r[f"eye_{s}_{p}"] for s in ("left", "right") for p in ("upper", "lower")]))

@@ -28,7 +28,7 @@ from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
 from .losses import LossWeights, total_loss
-from .metrics import eye_region, lip_region
+from .metrics import eye_region, inner_lip_pairs, lip_region
 
 
 def load_checkpoint(path: Path, template=None):
@@ -71,6 +71,7 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--frontend", help="a speech front-end trained on its own (talkingface.frontend.train: OUT/frontend.pt): "
                     "its content encoder replaces the model's and stays frozen")
     ap.add_argument("--tune-frontend", action="store_true", help="with --frontend: fine-tune it with the face instead of freezing it")
+    ap.add_argument("--gap-weight", type=float, default=LossWeights.gap, help="weight of the inner-lip gap term (losses.py)")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -135,10 +136,11 @@ def main(argv=None) -> int:
 
     eye = torch.from_numpy(eye_region(ds.template))
     lips = torch.from_numpy(lip_region(ds.template))
+    pairs = torch.from_numpy(inner_lip_pairs(ds.template))
     rng = np.random.default_rng(args.seed * 1000 + rank + step)
     budget_steps = args.steps
     total_est = budget_steps or 0
-    weights = LossWeights.paper() if args.paper_loss else LossWeights(lips=args.lip_weight)
+    weights = LossWeights.paper() if args.paper_loss else LossWeights(lips=args.lip_weight, gap=args.gap_weight)
 
     def save(path: Path) -> None:
         if rank != 0:
@@ -167,7 +169,7 @@ def main(argv=None) -> int:
             g["lr"] = args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
         b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
         out_ = net(b.mel, b.mel_index, b.template)
-        loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights)
+        loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights, pairs)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
@@ -178,7 +180,7 @@ def main(argv=None) -> int:
             avg = {k: np.mean([h[k] for h in history[-20:]]) for k in parts}
             rate = step / max(time.time() - start, 1e-9)
             left = ((budget_steps - step) / rate) if budget_steps else (60 * args.minutes - trained_seconds)
-            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  unposed {avg['rec_unposed']:.3f} mm  lips {avg['rec_lips']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
+            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  unposed {avg['rec_unposed']:.3f} mm  lips {avg['rec_lips']:.3f} mm  gap {avg['gap']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
                 f"phones {avg['content']:.3f}  lr {opt.param_groups[0]['lr']:.1e}  {rate:.2f} steps/s  ~{left / 60:.1f} min left")
         if step % args.checkpoint_every == 0:
             save(ck_path)
