@@ -7,6 +7,8 @@ import { loadTemplate, lipMask as lipMaskOf } from '../template/face-template';
 import { FaceView } from '../render/face-view';
 import { detectWebGPU } from '../gpu/capabilities';
 import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
+import { innerLipGaps } from '../template/lip-gap';
+import { LipTimeline } from './timeline';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio, levels } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
@@ -40,6 +42,8 @@ const exportGlbButton = $<HTMLButtonElement>('export-glb');
 const exportRawButton = $<HTMLButtonElement>('export-raw');
 const stage = $<HTMLElement>('stage');
 const dropHint = $<HTMLParagraphElement>('drop-hint');
+const timeline = new LipTimeline($<HTMLCanvasElement>('timeline'));
+addEventListener('resize', () => timeline.redraw());
 
 function showStatus(text: string, isError = false): void {
   status.textContent = text;
@@ -66,11 +70,15 @@ interface Truth {
   unposed: Float32Array;
   pose: Float32Array;
   frames: number;
+  /** The sample's inner-lip gap per frame (mm) and aligned phones, from its index (for the timeline). */
+  lipGapMm?: number[];
+  phones?: [string, number, number][];
 }
 
 interface SampleEntry {
   name: string; text: string; voice: string; source: string; frames: number; seconds: number;
   audio: string; ground_truth: string; vertices: number; audio_sha256: string; ground_truth_sha256: string;
+  lip_gap_mm: number[]; phones: [string, number, number][];
 }
 
 const SAMPLES_URL = '/models/samples/index.json';
@@ -187,8 +195,19 @@ function setTake(t: Take, notes: string[] = []): void {
   exportRawButton.disabled = false;
   scrub.disabled = false;
   scrub.max = String(t.animation.frames - 1);
+  showTimeline(t);
   showFrame(0);
   document.body.dataset.take = 'ready';
+}
+
+/** The lip timeline of a take: predicted gap and heard phones, and the truth's for a sample clip. */
+function showTimeline(t: Take): void {
+  const e = engine;
+  const a = t.animation;
+  if (!e || !a.unposed) return timeline.clear();
+  const { lips_inner_upper: upper, lips_inner_lower: lower } = view.template.regions;
+  const gap = innerLipGaps(a.unposed, a.frames, view.template.vertexCount, upper, lower).map((g) => g / e.unitsPerMm);
+  timeline.show({ fps: a.fps, gap, heard: Array.from(a.phones, (k) => e.manifest.content_phones[k]), truthGap: t.truth?.lipGapMm, truthPhones: t.truth?.phones });
 }
 
 /** Frame f of the prediction as drawn: on the sample subject's own face when there is ground truth. */
@@ -220,6 +239,7 @@ function showFrame(frame: number): void {
     const q = truth.pose;
     truthView.setPose(q[g * 6], q[g * 6 + 1], q[g * 6 + 2], q[g * 6 + 3], q[g * 6 + 4], q[g * 6 + 5]);
   }
+  timeline.setPlayhead(f);
   scrub.value = String(f);
   timeLabel.value = `${(f / take.animation.fps).toFixed(2)} s`;
   paint();
@@ -346,7 +366,7 @@ async function openSample(name: string): Promise<void> {
     }
     const n = view.template.vertexCount;
     if (c.vertices !== n) throw new Error(`the sample has ${c.vertices} vertices, the face ${n}`);
-    const truth = decodeTruth(truthBytes, n, c.frames, e.unitsPerMm);
+    const truth = { ...decodeTruth(truthBytes, n, c.frames, e.unitsPerMm), lipGapMm: c.lip_gap_mm, phones: c.phones };
     lipMask ??= lipMaskOf(view.template);
     const audio = await decodeAudio(audioBytes, e.manifest.audio.sample_rate);
     e.resetTimes();
@@ -513,14 +533,16 @@ function joinFrames(chunks: Frames[], fps: number): Animation {
   const vertices = new Float32Array(count * per);
   const unposed = new Float32Array(count * per);
   const pose = new Float32Array(count * 6);
+  const phones = new Uint8Array(count);
   let i = 0;
   for (const f of chunks) {
     vertices.set(f.vertices, i * per);
     unposed.set(f.unposed, i * per);
     pose.set(f.pose, i * 6);
+    phones.set(f.phones, i);
     i += f.count;
   }
-  return { fps, frames: count, vertices, pose, unposed };
+  return { fps, frames: count, vertices, pose, unposed, phones };
 }
 
 sampleSelect.addEventListener('change', () => {

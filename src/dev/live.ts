@@ -6,6 +6,7 @@
  */
 import { TalkingFaceEngine } from '../engine/engine';
 import { openMicrophone } from '../audio/capture';
+import { innerLipGaps } from '../template/lip-gap';
 
 function lipGaps(unposed: Float32Array, count: number, n: number, upper: Uint32Array, lower: Uint32Array): number[] {
   // Mean vertical distance between the inner-lip contours, per frame (template units).
@@ -20,16 +21,19 @@ function lipGaps(unposed: Float32Array, count: number, n: number, upper: Uint32A
 }
 
 async function main() {
-  const seconds = Number(new URLSearchParams(location.search).get('seconds') ?? '3');
+  const params = new URLSearchParams(location.search);
+  const seconds = Number(params.get('seconds') ?? '3');
   const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
   const n = engine.template.vertexCount;
   const { lips_inner_upper: upper, lips_inner_lower: lower } = engine.template.regions;
   const streamed: Float32Array[] = [];
   const gaps: number[] = [];
+  const contour: number[] = [];
   const media = await openMicrophone();
   const live = await engine.listen(media, (_, frames) => {
     streamed.push(frames.vertices.slice());
     gaps.push(...lipGaps(frames.unposed, frames.count, n, upper, lower));
+    contour.push(...innerLipGaps(frames.unposed, frames.count, n, upper, lower));
   }, { maxLagFrames: Infinity }); // every frame, so the stream can be compared with the offline animation
   await new Promise((r) => setTimeout(r, seconds * 1000));
   const latency = live.stream.latency;
@@ -55,6 +59,9 @@ async function main() {
     tracksEnded: media.getTracks().every((t) => t.readyState === 'ended'),
     mmPerUnit: 1 / engine.unitsPerMm,
     gaps,
+    contourGaps: contour,
+    // ?take=1: the captured samples too, so a test can find where in the played file the take began.
+    take: params.get('take') ? Array.from(take) : undefined,
   };
 }
 

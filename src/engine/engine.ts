@@ -67,6 +67,8 @@ export interface Animation {
   pose: Float32Array;
   /** (frames x N x 3) I + O in the template's units, when asked for. */
   unposed?: Float32Array;
+  /** (frames): the content class the encoder heard most at each frame (names: manifest.content_phones). */
+  phones: Uint8Array;
 }
 
 export interface StageTimes {
@@ -88,12 +90,24 @@ function contentContextBack(manifest: Manifest): number {
   return Math.ceil(Math.max(MEL_CONTEXT, manifest.receptive_field.content_mel_frames_back) / stride) * stride;
 }
 
+/** The most probable content class at each frame's content position (`post` holds content frames from cLo). */
+function heardPhones(post: Float32Array, melIndex: number[], stride: number, classes: number, cLo: number): Uint8Array {
+  return Uint8Array.from(melIndex, (k) => {
+    const row = (Math.floor(k / stride) - cLo) * classes;
+    let best = 0;
+    for (let j = 1; j < classes; j++) if (post[row + j] > post[row + best]) best = j;
+    return best;
+  });
+}
+
 /** Frames of one chunk: posed vertices and I + O in the template's units, poses (axis-angle, mm). */
 export interface Frames {
   count: number;
   vertices: Float32Array;
   unposed: Float32Array;
   pose: Float32Array;
+  /** (count): the content class heard most at each frame (manifest.content_phones). */
+  phones: Uint8Array;
 }
 
 /** What carries from one chunk to the next: the pose LSTM's state and the pose features still needed. */
@@ -250,6 +264,7 @@ export class TalkingFaceEngine {
     const vertices = keep ? new Float32Array(F * n * 3) : new Float32Array(0);
     const pose = new Float32Array(F * 6);
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
+    const phones = new Uint8Array(F);
     const state = newProducerState(this.manifest.model.config.pose_channels);
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
@@ -259,10 +274,11 @@ export class TalkingFaceEngine {
       pose.set(out.pose, f0 * 6);
       if (keep) vertices.set(out.vertices, f0 * n * 3);
       unposed?.set(out.unposed, f0 * n * 3);
+      phones.set(out.phones, f0);
       options.onFrames?.(f0, out.vertices, out.pose);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones };
   }
 
   /**
@@ -330,6 +346,7 @@ export class TalkingFaceEngine {
     const runOffset = melLo / m.content_stride;
     const post = softmaxRows(logits.slice((cLo - runOffset) * m.content_classes, (cHi - runOffset) * m.content_classes), m.content_classes);
     const windows = contentWindows(post, melIndex, m, cLo, Number.isFinite(Kc) ? Kc : undefined);
+    const phones = heardPhones(post, melIndex, m.content_stride, m.content_classes, cLo);
     this.times.content += performance.now() - t;
 
     t = performance.now();
@@ -387,7 +404,7 @@ export class TalkingFaceEngine {
       unposed[i] = (this.templateMm[i % n3] + decoded.offsets[i]) / this.mmPerUnit;
     }
     this.times.posing += performance.now() - t;
-    return { count: melIndex.length, vertices: y, unposed, pose: decoded.pose };
+    return { count: melIndex.length, vertices: y, unposed, pose: decoded.pose, phones };
   }
 
   private async decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {

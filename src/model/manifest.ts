@@ -45,6 +45,8 @@ export interface Manifest {
   /** Mel frames each encoder output reads after its own position (look-ahead) and before it (context). */
   receptive_field: { content_mel_frames: number; pose_mel_frames: number; content_mel_frames_back: number; pose_mel_frames_back: number };
   look_ahead_ms: number;
+  /** The content encoder's classes in logit order (ARPAbet phones, SIL, <blank>). */
+  content_phones: string[];
 }
 
 export class ManifestError extends Error {
@@ -57,6 +59,9 @@ export function checkManifest(m: unknown): Manifest {
   if (x.version !== 1) throw new ManifestError(`model manifest version ${x.version} is not supported by this build (1)`);
   for (const key of ['sample_rate', 'frame_size', 'hop', 'n_mels', 'fps'] as const) {
     if (!Number.isFinite(x.audio?.[key])) throw new ManifestError(`model manifest lacks audio.${key}`);
+  }
+  if (!Array.isArray(x.content_phones) || x.content_phones.length !== x.model?.config?.content_classes) {
+    throw new ManifestError('model manifest lacks content_phones, one name per content class (re-export the model)');
   }
   for (const key of ['content_mel_frames', 'pose_mel_frames', 'content_mel_frames_back', 'pose_mel_frames_back'] as const) {
     if (!Number.isFinite(x.receptive_field?.[key])) throw new ManifestError(`model manifest lacks receptive_field.${key} (re-export the model)`);

@@ -28,6 +28,7 @@ import torch
 import torch.nn as nn
 
 from .data.datasets import read_wav
+from .corpus.phonemes import PHONES
 from .features import AudioConfig, frame_to_mel_index, log_mel
 from .model.gava import TalkingFace
 from .paths import MODELS_DIR, TEMPLATE_DIR
@@ -235,6 +236,8 @@ def export(checkpoint: Path, out: Path) -> dict:
              {"vertices": ["1", "T", template.num_vertices, 3], "offsets": ["1", "T", template.num_vertices, 3], "pose": ["1", "T", 6]}),
         ]},
         "decoder_tensors": {k: list(v.shape) for k, v in weights.items()},
+        # The content encoder's classes in logit order: what the engine names the phone it heard at each frame.
+        "content_phones": [*PHONES, "<blank>"][: cfg.content_classes],
         "fixtures": fixtures,
         "receptive_field": receptive_field(model),
         "look_ahead_ms": round(1000 * ((cfg.window_future * cfg.content_stride + receptive_field(model)["content_mel_frames"]) / a.feature_rate

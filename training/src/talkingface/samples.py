@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .corpus.checks import lip_gap_mm
 from .data.datasets import open_dataset, write_wav
 
 DEFAULT_COUNT = 3
@@ -56,7 +57,12 @@ def write_sample(ds, key: str, out: Path) -> dict:
     write_wav(out / f"{key}.wav", clip.audio, clip.sample_rate)
     return {"name": key, "text": clip.meta.get("text", ""), "voice": clip.meta.get("voice", ""), "source": clip.meta.get("source", ""),
             "subject": clip.subject, "frames": int(clip.num_frames), "fps": float(ds.fps), "seconds": float(len(clip.audio) / clip.sample_rate),
-            "audio": f"{key}.wav", "ground_truth": f"{key}.gt.bin", "vertices": int(clip.vertices.shape[1])}
+            "audio": f"{key}.wav", "ground_truth": f"{key}.gt.bin", "vertices": int(clip.vertices.shape[1]),
+            # The aligned phones (ARPAbet, start s, end s): the demo's timeline labels and the e2e closure test.
+            "phones": [[p, round(float(a), 4), round(float(b), 4)] for p, a, b in clip.phones or []],
+            # The truth's inner-lip gap per frame (mm, corpus/checks.py): the timeline's truth curve, and the
+            # fixture src/template/lip-gap.ts is tested against.
+            "lip_gap_mm": np.round(lip_gap_mm(clip, ds.template, mm), 4).tolist()}
 
 
 def main(argv=None) -> int:
