@@ -19,16 +19,18 @@ import torch
 from ..corpus.pose import apply_pose as apply_pose_np
 from ..data.datasets import open_dataset
 from . import articulation as art
+from . import head_motion as hm
+from ..features import frame_to_mel_index
 from .data import prepare
 from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
 
 
-def evaluate(model, ds, split: str = "test", progress=None) -> dict:
+def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None) -> dict:
     model.eval()
     t = ds.template
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
-    per_clip, artic = [], []
+    per_clip, artic, heads = [], [], []
     D = model.cfg.content_classes
     confusion = {"all": np.zeros((D, D), np.int64), "human": np.zeros((D, D), np.int64)}
     heard = {"all": [0, 0], "human": [0, 0]}
@@ -44,6 +46,8 @@ def evaluate(model, ds, split: str = "test", progress=None) -> dict:
         per_clip.append(m)
         a = art.clip_articulation(art.inner_lip_gap(c.vertices, t), art.inner_lip_gap(pred_unposed, t), c.segments, ds.fps)
         artic.append(a | {"source": c.source})
+        mel_index = frame_to_mel_index(np.arange(c.num_frames), model.audio)
+        heads.append(hm.clip_head_motion(c.pose, pred_pose, hm.envelope(c.mel, mel_index)) | {"source": c.source})
         with torch.no_grad():
             logits = model.content(mel[None])[0].numpy()                      # (Kc, D)
         labels = c.phones[:: model.cfg.content_stride]
@@ -68,9 +72,13 @@ def evaluate(model, ds, split: str = "test", progress=None) -> dict:
                     "human": art.summarise(human)}
     content = {"all": art.content_summary(confusion["all"], heard["all"]),
                "human": art.content_summary(confusion["human"], heard["human"]) if human else None}
+    if head_rows is not None:  # the per-clip speeds, for the Fig. 4 plot
+        head_rows.extend(heads)
+    head = {"all": hm.summarise(heads), "synthetic": hm.summarise([r for r in heads if r["source"] != "human"]),
+            "human": hm.summarise([r for r in heads if r["source"] == "human"])}
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
             "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t),
-            "articulation": articulation, "content_encoder": content, "per_clip": per_clip}
+            "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
 
 def silence_probe(model, template) -> dict:
@@ -98,7 +106,8 @@ def main(argv=None) -> int:
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
     t0 = time.time()
-    res = evaluate(model, ds, args.split)
+    heads: list = []
+    res = evaluate(model, ds, args.split, head_rows=heads)
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
     res["eval_seconds"] = time.time() - t0
@@ -115,12 +124,15 @@ def main(argv=None) -> int:
     if args.out:
         out = Path(args.out)
         out.parent.mkdir(parents=True, exist_ok=True)
+        plot = out.with_name(out.stem + "_head_motion.png")
+        hm.plot_speed_histogram(heads, plot, f"{ck['model_config']['features']}+{ck['model_config']['decoder']}, "
+                                             f"{args.split} split: head rotation per frame")
         out.write_text(json.dumps(res, indent=1))
-        out.with_suffix(".md").write_text(markdown(res, args, ck))
+        out.with_suffix(".md").write_text(markdown(res, args, ck, plot.name))
     return 0
 
 
-def markdown(res: dict, args, ck: dict) -> str:
+def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
     cfg = ck["model_config"]
     rows = []
     for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
@@ -152,6 +164,7 @@ def markdown(res: dict, args, ck: dict) -> str:
         f"{res['silence']['neutral_template_gap_mm']:.2f}).",
         "",
         *art.markdown(res),
+        *hm.markdown(res, head_plot),
     ])
 
 

@@ -1,0 +1,115 @@
+"""Measures of head motion that a still head cannot satisfy (issue 15).
+
+Head motion is one-to-many: a regression onto it converges to the mean, a head that barely moves, and the
+pose error (an angle to the truth, frame by frame) rewards exactly that. What a viewer notices is how much the
+head moves and whether it moves with the speech:
+
+- spread: the standard deviation of each rotation axis within a clip, predicted / true (per axis and in all);
+- the distribution of head movement (the paper's Fig. 4): angular speed per frame, predicted against true, with
+  their 1-D Wasserstein distance and a histogram plot;
+- following speech: the correlation, within each clip, of the head's angular speed with the speech envelope
+  (mean log-Mel energy), predicted and true;
+- jitter (the mean second difference) against the truth's.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+AXES = ("pitch", "yaw", "roll")  # rotation about x, y, z (axis-angle components, template axes)
+
+
+def angular_speed_deg(pose: np.ndarray) -> np.ndarray:
+    """(F, 6) -> (F-1,) rotation between consecutive frames, degrees (small angles: the axis-angle difference)."""
+    return np.degrees(np.linalg.norm(np.diff(pose[:, :3], axis=0), axis=1))
+
+
+def envelope(mel: np.ndarray, mel_index: np.ndarray) -> np.ndarray:
+    """Speech loudness per frame: the mean log-Mel band at each frame's Mel position."""
+    return mel[np.clip(mel_index, 0, len(mel) - 1)].mean(1)
+
+
+def _corr(a: np.ndarray, b: np.ndarray) -> float:
+    n = min(len(a), len(b))
+    a, b = a[:n], b[:n]
+    return float(np.corrcoef(a, b)[0, 1]) if n > 2 and a.std() > 1e-9 and b.std() > 1e-9 else 0.0
+
+
+def clip_head_motion(true_pose: np.ndarray, pred_pose: np.ndarray, env: np.ndarray) -> dict:
+    n = min(len(true_pose), len(pred_pose))
+    t, p = true_pose[:n], pred_pose[:n]
+    speed_t, speed_p = angular_speed_deg(t), angular_speed_deg(p)
+    # Envelope change between the same consecutive frames: the head moves on stressed, loud syllables.
+    loud = np.abs(np.diff(env[:n])) + 0.5 * (env[1:n] - env[:n].mean())
+    return {"std_true": np.degrees(t[:, :3].std(0)).tolist(), "std_pred": np.degrees(p[:, :3].std(0)).tolist(),
+            "speed_true": speed_t, "speed_pred": speed_p,
+            "follow_true": _corr(speed_t, loud), "follow_pred": _corr(speed_p, loud)}
+
+
+def wasserstein_1d(a: np.ndarray, b: np.ndarray, points: int = 200) -> float:
+    q = np.linspace(0, 1, points)
+    return float(np.mean(np.abs(np.quantile(a, q) - np.quantile(b, q))))
+
+
+def summarise(rows: list[dict]) -> dict | None:
+    if not rows:
+        return None
+    st, sp = np.array([r["std_true"] for r in rows]), np.array([r["std_pred"] for r in rows])  # (clips, 3)
+    speed_t = np.concatenate([r["speed_true"] for r in rows])
+    speed_p = np.concatenate([r["speed_pred"] for r in rows])
+    ft, fp = float(np.mean([r["follow_true"] for r in rows])), float(np.mean([r["follow_pred"] for r in rows]))
+    return {"spread_true_deg": float(np.linalg.norm(st.mean(0))), "spread_pred_deg": float(np.linalg.norm(sp.mean(0))),
+            "spread_ratio": float(np.linalg.norm(sp.mean(0)) / max(np.linalg.norm(st.mean(0)), 1e-9)),
+            "spread_ratio_axes": {a: float(sp[:, i].mean() / max(st[:, i].mean(), 1e-9)) for i, a in enumerate(AXES)},
+            "speed_true_mean_deg": float(speed_t.mean()), "speed_pred_mean_deg": float(speed_p.mean()),
+            "speed_wasserstein_deg": wasserstein_1d(speed_t, speed_p),
+            "follow_true": ft, "follow_pred": fp, "follow_ratio": fp / ft if abs(ft) > 1e-9 else 0.0}
+
+
+def plot_speed_histogram(rows: list[dict], path: Path, title: str) -> None:
+    """The paper's Fig. 4: how often the head moves how fast, the truth against the model."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    t = np.concatenate([r["speed_true"] for r in rows])
+    p = np.concatenate([r["speed_pred"] for r in rows])
+    bins = np.linspace(0, max(np.quantile(t, 0.99), np.quantile(p, 0.99), 1e-3), 40)
+    fig, ax = plt.subplots(figsize=(6, 3.2), dpi=110)
+    ax.hist(np.clip(t, 0, bins[-1]), bins, alpha=0.6, label="truth", density=True)
+    ax.hist(np.clip(p, 0, bins[-1]), bins, alpha=0.6, label="model", density=True)
+    ax.set_xlabel("head rotation per frame (degrees)")
+    ax.set_ylabel("density")
+    ax.set_title(title, fontsize=9)
+    ax.legend()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def markdown(res: dict, plot_name: str) -> list[str]:
+    rows = []
+    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+        h, m = res["head_motion"][name], res[name]
+        if h:
+            ax = h["spread_ratio_axes"]
+            rows.append(f"| {label} | {h['spread_true_deg']:.2f} / {h['spread_pred_deg']:.2f} | **{h['spread_ratio']:.2f}** "
+                        f"({ax['pitch']:.2f} / {ax['yaw']:.2f} / {ax['roll']:.2f}) | {h['speed_true_mean_deg']:.3f} / "
+                        f"{h['speed_pred_mean_deg']:.3f} | {h['speed_wasserstein_deg']:.3f} | {h['follow_true']:.2f} / "
+                        f"{h['follow_pred']:.2f} | {m['pose_jitter_gt_deg']:.3f} / {m['pose_jitter_deg']:.3f} |")
+    return [
+        "## Head motion",
+        "",
+        "Spread: standard deviation of the head rotation within a clip (degrees, the three axes' norm), true / predicted,",
+        "and their ratio (per axis: pitch / yaw / roll). Speed: rotation per frame; W1: the 1-D Wasserstein distance",
+        "between the true and predicted speed distributions (degrees). Follows speech: correlation within a clip of",
+        "the head's speed with the speech envelope's change, true / predicted. Jitter: true / predicted.",
+        "",
+        "| clips | spread (deg) | spread ratio (pitch / yaw / roll) | speed (deg/frame) | speed W1 | follows speech | jitter (deg) |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        *rows,
+        "",
+        f"![head movement distribution, truth against model (the paper's Fig. 4)]({plot_name})",
+        "",
+    ]
