@@ -127,6 +127,7 @@ export class GpuDecoder {
   /** tokens (F x N x d), poseToken (F x d) -> offsets (F x N x 3) mm, pose (F x 6). Calls are serialised. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
     const run = this.busy.then(() => this.run(tokens, poseToken, frames));
+    // Deliberate: the caller receives the run's error through `run`; `busy` only orders the runs.
     this.busy = run.catch(() => undefined);
     return run;
   }

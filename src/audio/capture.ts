@@ -189,7 +189,17 @@ export class AudioCapture {
     };
     source.connect(node);
     if (options.monitor) source.connect(context.destination);
-    if (context.state === 'suspended') await context.resume().catch(() => undefined);
+    if (context.state === 'suspended') {
+      try {
+        await context.resume();
+      } catch (e) {
+        // A context that cannot run delivers no samples: say so rather than record silence.
+        source.disconnect();
+        node.disconnect();
+        await context.close();
+        throw new Error(`the audio system would not start (${(e as Error).message}); click the page and try again`);
+      }
+    }
     return new AudioCapture(context, node, source, stream, sampleRate, rate, capture);
   }
 
@@ -212,6 +222,7 @@ export class AudioCapture {
     this.source.disconnect();
     this.node.disconnect();
     if (releaseStream) for (const t of this.stream.getTracks()) t.stop();
+    // Deliberate: closing can only fail on a context that is already closed, which is the goal.
     await this.context.close().catch(() => undefined);
   }
 }

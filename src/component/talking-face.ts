@@ -152,9 +152,10 @@ export class TalkingFaceElement extends HTMLElement {
         (e: Error) => this.fail('model', `cannot switch to ${value}: ${e.message}`),
       );
     } else if (name === 'src' && value && this.engine) {
+      // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined);
     } else if (name === 'live' && this.engine) {
-      if (value !== null) void this.startMicrophone().catch(() => undefined);
+      if (value !== null) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
       else this.stop();
     }
   }
@@ -298,6 +299,7 @@ export class TalkingFaceElement extends HTMLElement {
       detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name },
     }));
     const src = this.getAttribute('src');
+    // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined);
     else if (src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined);
   }

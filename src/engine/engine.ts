@@ -569,6 +569,7 @@ export class StreamSession {
 
   private schedule(job: () => Promise<void>): Promise<void> {
     const run = this.busy.then(job);
+    // Deliberate: the caller receives the run's error through `run`; `busy` only orders the runs.
     this.busy = run.catch(() => undefined);
     return run;
   }

@@ -98,6 +98,8 @@ export class OnnxModel {
       }
       return result;
     });
+    // Deliberate: the caller receives the job's error through `job`; the queue only orders runs, and one failed
+    // run must not stop the next.
     this.queue = job.catch(() => undefined);
     return job;
   }

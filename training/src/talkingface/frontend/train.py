@@ -21,6 +21,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
+from ..corpus.phonemes import BILABIALS, PHONE_INDEX
 from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
@@ -125,6 +126,10 @@ def main(argv=None) -> int:
     ap.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--eval-every", type=int, default=500)
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    ap.add_argument("--no-corpus-train", action="store_true",
+                    help="leave out the mesh corpus's train split (by default its speech trains the front-end too)")
+    ap.add_argument("--bilabial-weight", type=float, default=2.0,
+                    help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
@@ -136,6 +141,8 @@ def main(argv=None) -> int:
     clips = load_speech(args.speech)
     ds = open_dataset(args.corpus)
     held = {split: [prepare(ds, k, audio) for k in ds.keys(split)] for split in ("val", "test")}
+    if not args.no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
+        clips += [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys("train"))]
     log(f"front-end: {len(clips)} clips, {sum(len(m) for m, _ in clips) / audio.feature_rate / 60:.1f} min of speech; "
         f"measured on {len(held['val'])} val / {len(held['test'])} test clips of {args.corpus}")
 
@@ -144,6 +151,8 @@ def main(argv=None) -> int:
     enc.norm.mean.copy_(torch.from_numpy(allmel.mean(0)))
     enc.norm.std.copy_(torch.from_numpy(allmel.std(0) + 1e-3))
     del allmel
+    class_weight = torch.ones(cfg.content_classes)
+    class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight
     opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)
     step, trained, history = 0, 0.0, []
     ck_path = args.out / "checkpoint.pt"
@@ -171,7 +180,7 @@ def main(argv=None) -> int:
         mel, lab = batch(clips, rng, args.batch, cfg.content_stride)
         logits = forward_augmented(enc, mel, rng)
         k = min(logits.shape[1], lab.shape[1])
-        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), ignore_index=-100)
+        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=-100)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
