@@ -40,6 +40,7 @@ async function main(): Promise<void> {
     await ready(page, 'take', 'ready');
     await page.locator('#scrub').fill('45');
     await page.screenshot({ path: resolve(OUT, 'sample.png') });
+    await page.locator('#timeline').screenshot({ path: resolve(OUT, 'timeline.png') });
     await page.locator('#side-check').check();
     await page.locator('#arrows-check').check();
     await page.locator('#paint-select').selectOption('error');
