@@ -127,6 +127,14 @@ async function start(): Promise<void> {
     showStatus(`${baseStatus} Model ${engine.manifest.model.name} ready. Decoder: ${engine.backend} (${engine.backendReason}; CPU decoder: ${engine.cpuKernel === 'wasm-simd' ? 'WebAssembly SIMD' : 'JavaScript'} on ${engine.cpuThreads} thread${engine.cpuThreads > 1 ? 's' : ''}). Open or drop an audio file, or record.`);
     document.body.dataset.engine = 'ready';
     void loadSampleIndex();
+    const e = engine;
+    e.restFace().then(
+      (rest) => {
+        if (!take) view.setVertices(rest); // the mouth closed at rest, not the opened template
+        document.body.dataset.rest = 'shown';
+      },
+      (err: Error) => showStatus(`The face at rest could not be computed: ${err.message}`, true),
+    );
   } catch (e) {
     showStatus(`${baseStatus} The model could not be loaded: ${(e as Error).message}. The face can still be viewed.`, true);
     document.body.dataset.engine = 'error';

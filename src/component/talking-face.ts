@@ -294,6 +294,10 @@ export class TalkingFaceElement extends HTMLElement {
         return;
       }
     }
+    engine.restFace().then(
+      (rest) => { if (!this.animation) this.view?.setVertices(rest); }, // the mouth closed at rest, not the opened template
+      (e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`),
+    );
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
       detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name },

@@ -480,6 +480,18 @@ export class TalkingFaceEngine {
     this.backendReason = `WebGPU: ${support.description}`;
   }
 
+  /** The face the model makes in silence (I + O in the template's units, the last frame of a second of silence):
+   * what a face shows before and between speech, instead of the template, whose mouth was opened for the lips
+   * to part. Computed once. */
+  restFace(): Promise<Float32Array> {
+    const n3 = this.template.vertexCount * 3;
+    this.rest ??= this.animate(new Float32Array(this.manifest.audio.sample_rate), { unposed: true })
+      .then((a) => a.unposed!.slice((a.frames - 1) * n3, a.frames * n3));
+    return this.rest;
+  }
+
+  private rest: Promise<Float32Array> | null = null;
+
   resetTimes(): void {
     for (const k of Object.keys(this.times) as (keyof StageTimes)[]) this.times[k] = 0;
   }

@@ -84,6 +84,11 @@ export class FaceView {
   }
 
   /** Replace the face's vertices (N x 3, template units) in place. */
+  /** The vertices drawn now (template units), read-only. */
+  get shownVertices(): Float32Array {
+    return this.positions.array as Float32Array;
+  }
+
   setVertices(vertices: Float32Array): void {
     if (vertices.length !== this.positions.array.length) {
       throw new Error(`setVertices: expected ${this.positions.array.length / 3} vertices, got ${vertices.length / 3}`);
