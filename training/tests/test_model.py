@@ -162,3 +162,17 @@ def test_metrics_on_known_errors(template):
     pose2 = pose.copy()
     pose2[:, 1] = np.radians(3)
     assert metrics.rotation_angle_deg(pose, pose2) == pytest.approx(np.full(5, 3.0))
+
+
+def test_the_closure_weight_counts_missed_closures_more():
+    torch.manual_seed(0)
+    v = torch.zeros(1, 2, 4, 3)
+    v[..., 0, 1] = 5.0                     # pair (0, 1): open 5 mm; pair (2, 3): closed (0 mm)
+    pred = v.clone()
+    pred[..., 2, 1] += 2.0                 # the closed pair left 2 mm open: a missed closure
+    pairs = torch.tensor([[0, 1], [2, 3]])
+    out = {"vertices": pred, "unposed": pred, "pose": torch.zeros(1, 2, 6), "offsets": pred, "content_logits": torch.zeros(1, 1, 41)}
+    args = (v, torch.zeros(1, 2, 6), torch.zeros(1, 4, 3), torch.full((1, 1), -100), torch.arange(1), torch.arange(4))
+    _, plain = losses.total_loss(out, *args, lip_pairs=pairs)
+    _, weighted = losses.total_loss(out, *args, w=losses.LossWeights(closure=4.0), lip_pairs=pairs)
+    assert plain["gap"] == pytest.approx(1.0) and weighted["gap"] == pytest.approx(2.0 * 5 / 6)

@@ -37,6 +37,7 @@ class LossWeights:
     unposed: float = 1.0     # reconstruction of I + O as well (0: the paper's Eq. 3 exactly)
     lips: float = 1.0        # reconstruction of I + O over the lip vertices alone (0: the paper's Eq. 3 exactly)
     gap: float = 1.0         # L1 on the inner-lip gap (0: the paper's Eq. 3 exactly)
+    closure: float = 0.0     # extra weight of the gap term where the true lips are closed (gap < 1 mm)
 
     @classmethod
     def paper(cls) -> "LossWeights":
@@ -93,8 +94,13 @@ def total_loss(out: dict, vertices: torch.Tensor, pose: torch.Tensor, template: 
     logits = out["content_logits"]
     kc = min(logits.shape[1], content_labels.shape[1])
     parts["content"] = F.cross_entropy(logits[:, :kc].flatten(0, 1), content_labels[:, :kc].flatten(), ignore_index=-100)
-    parts["gap"] = (lip_gap(vertices, lip_pairs) - lip_gap(out["unposed"], lip_pairs)).abs().mean() if lip_pairs is not None \
-        else torch.zeros(())
+    if lip_pairs is not None:
+        true_gap = lip_gap(vertices, lip_pairs)                               # (B, T, P) mm
+        # A closure is brief and a miss is what a viewer sees: its frames can weigh more (w.closure).
+        weight = 1.0 + w.closure * (true_gap < 1.0).float()
+        parts["gap"] = (weight * (true_gap - lip_gap(out["unposed"], lip_pairs)).abs()).sum() / weight.sum()
+    else:
+        parts["gap"] = torch.zeros(())
     loss = parts["rec"] + w.unposed * parts["rec_unposed"] + w.lips * parts["rec_lips"] + w.velocity * parts["vel"] + w.pose * parts["pose"] \
         + w.eye * parts["eye"] + w.content * parts["content"] + w.gap * parts["gap"]
     return loss, {k: float(v.detach()) for k, v in parts.items()}

@@ -71,6 +71,9 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--frontend", help="a speech front-end trained on its own (talkingface.frontend.train: OUT/frontend.pt): "
                     "its content encoder replaces the model's and stays frozen")
     ap.add_argument("--tune-frontend", action="store_true", help="with --frontend: fine-tune it with the face instead of freezing it")
+    ap.add_argument("--closure-weight", type=float, default=LossWeights.closure,
+                    help="extra weight of the gap term on frames where the true lips are closed (losses.py)")
+    ap.add_argument("--init", help="start from this checkpoint's weights (same config; a new run: fresh optimiser and schedule)")
     ap.add_argument("--gap-weight", type=float, default=LossWeights.gap, help="weight of the inner-lip gap term (losses.py)")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
@@ -118,6 +121,12 @@ def main(argv=None) -> int:
         model.content.load_state_dict(frontend["content"])
         model.content.requires_grad_(args.tune_frontend)
         log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
+    if args.init:
+        init = torch.load(args.init, map_location="cpu", weights_only=False)
+        if init["model_config"] != cfg.to_dict():
+            raise SystemExit(f"--init: {args.init} is a {init['model_config']} model, not {cfg.to_dict()}")
+        model.load_state_dict(init["model"])
+        log(f"initialised from {args.init} (step {init['step']})")
     opt = torch.optim.Adam([p for p in model.parameters() if p.requires_grad], lr=args.lr)
     step, trained_seconds = 0, 0.0
     ck_path = out / "checkpoint.pt"
@@ -140,7 +149,7 @@ def main(argv=None) -> int:
     rng = np.random.default_rng(args.seed * 1000 + rank + step)
     budget_steps = args.steps
     total_est = budget_steps or 0
-    weights = LossWeights.paper() if args.paper_loss else LossWeights(lips=args.lip_weight, gap=args.gap_weight)
+    weights = LossWeights.paper() if args.paper_loss else LossWeights(lips=args.lip_weight, gap=args.gap_weight, closure=args.closure_weight)
 
     def save(path: Path) -> None:
         if rank != 0:
