@@ -75,13 +75,15 @@ describe('TypeScript + onnxruntime-node vs the PyTorch fixture', () => {
     expect(maxAbsDiff(win, f32(fx, 'windows'))).toBeLessThan(1e-6);
   });
 
-  it('the ONNX encoders on onnxruntime-node match PyTorch within 1e-5', async () => {
+  it('the ONNX encoders on onnxruntime-node match PyTorch within 1e-5 (logits: and 1e-6 of their scale)', async () => {
     const m = manifest.model.config;
     const mel = f32(fx, 'mel');
     const K = mel.length / manifest.audio.n_mels;
     const melT = new ort.Tensor('float32', mel, [1, K, manifest.audio.n_mels]);
     const logits = (await run(manifest.files.content_encoder, { mel: melT })).logits.data as Float32Array;
-    expect(maxAbsDiff(logits, f32(fx, 'content_logits'))).toBeLessThan(1e-5);
+    // Logits reach about 50: float32 carries 4e-6 there, so the bound grows with the tensor's scale (1e-6 of it).
+    const ref = f32(fx, 'content_logits');
+    expect(maxAbsDiff(logits, ref)).toBeLessThan(1e-5 + 1e-6 * ref.reduce((s, v) => Math.max(s, Math.abs(v)), 0));
     const win = f32(fx, 'windows');
     const F = win.length / (m.window * m.content_classes);
     const tokens = (await run(manifest.files.hierarchical, { windows: new ort.Tensor('float32', win, [F, m.window, m.content_classes]) })).tokens.data as Float32Array;
