@@ -19,6 +19,7 @@ import { spawn } from 'node:child_process';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
+import { readWav16 } from '../tests/e2e/helpers/audio';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -56,15 +57,6 @@ function calibrationSnapshots(perClass = 16): Record<string, number[][]> | null 
 
 type Phone = [string, number, number];
 interface Clip { key: string; source: string; samples: Float32Array; phones: Phone[] }
-
-function readWav16(path: string): Float32Array {
-  const b = readFileSync(path);
-  let o = 12;
-  while (b.toString('ascii', o, o + 4) !== 'data') o += 8 + b.readUInt32LE(o + 4);
-  if (b.readUInt32LE(24) !== 16000 || b.readUInt16LE(34) !== 16) throw new Error(`${path}: expected 16 kHz 16-bit PCM`);
-  const n = b.readUInt32LE(o + 4) / 2;
-  return Float32Array.from({ length: n }, (_, i) => b.readInt16LE(o + 8 + 2 * i) / 32768);
-}
 
 function loadClips(): { clips: Clip[]; from: string } {
   if (existsSync(resolve(CORPUS, 'splits.json'))) {

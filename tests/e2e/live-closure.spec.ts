@@ -2,6 +2,7 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
 import { fakeMicrophone } from '../../playwright.config';
+import { readWav16 } from './helpers/audio';
 
 /**
  * The lips close on /p b m/ in the browser (issue 14): a test-split sample clip (an unseen voice, sentence and
@@ -19,14 +20,6 @@ const clip = index.clips.map((c) => ({ c, n: c.phones.filter(([p]) => 'P B M'.sp
   .sort((a, b) => b.n - a.n)[0].c;
 const WAV = resolve(SAMPLES, clip.audio);
 test.use({ launchOptions: fakeMicrophone(WAV) });
-
-function readWav16(path: string): Float32Array {
-  const b = readFileSync(path);
-  let o = 12;
-  while (b.toString('ascii', o, o + 4) !== 'data') o += 8 + b.readUInt32LE(o + 4);
-  const n = b.readUInt32LE(o + 4) / 2;
-  return Float32Array.from({ length: n }, (_, i) => b.readInt16LE(o + 8 + 2 * i) / 32768);
-}
 
 /** Offset (samples) into the looped clip at which the take begins: coarse at 2 kHz, refined at 16 kHz. */
 function offsetInLoop(take: number[], clipAudio: Float32Array): number {

@@ -13,6 +13,16 @@ export function speechSamples(): { samples: Float32Array; rate: number } {
   return { samples, rate: 16000 };
 }
 
+/** A mono 16 kHz 16-bit PCM WAV file's samples (the corpus's and the sample clips' format), chunks walked to "data". */
+export function readWav16(path: string): Float32Array {
+  const b = readFileSync(path);
+  if (b.readUInt32LE(24) !== 16000 || b.readUInt16LE(34) !== 16 || b.readUInt16LE(22) !== 1) throw new Error(`${path}: expected 16 kHz mono 16-bit PCM`);
+  let o = 12;
+  while (b.toString('ascii', o, o + 4) !== 'data') o += 8 + b.readUInt32LE(o + 4);
+  const n = b.readUInt32LE(o + 4) / 2;
+  return Float32Array.from({ length: n }, (_, i) => b.readInt16LE(o + 8 + 2 * i) / 32768);
+}
+
 /** 16-bit PCM WAV; `channels` are interleaved from the given per-channel arrays. */
 export function wav(channels: Float32Array[], rate: number): Buffer {
   const n = channels[0].length;
