@@ -24,6 +24,7 @@ import json
 import sys
 import time
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -99,10 +100,16 @@ def plan(minutes: float, seed: int) -> list[SpeechSpec]:
     return specs
 
 
+@lru_cache(maxsize=1)
+def _recordings() -> dict:
+    """The recordings by name, read once per process (the transcripts are a gzip file)."""
+    return {r.name: r for r in recorded.recordings()}
+
+
 def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
     """Audio at sr and its phones (synthesiser timings or forced alignment)."""
     if spec.engine == "human":
-        rec = next(r for r in recorded.recordings() if r.name == spec.voice)
+        rec = _recordings()[spec.voice]
         audio, rate = read_wav(rec.path)
         audio = resample(audio, rate, sr)
         phones = None
