@@ -46,7 +46,7 @@ export default defineConfig({
     },
   },
   webServer: {
-    command: `npm run --silent build && npx vite preview --host 127.0.0.1 --port ${PORT} --strictPort`,
+    command: `npm run --silent build:test && npx vite preview --host 127.0.0.1 --port ${PORT} --strictPort`,
     url: `http://127.0.0.1:${PORT}/`,
     timeout: 120_000,
     reuseExistingServer: false,

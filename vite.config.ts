@@ -64,27 +64,32 @@ function modelsDir(): Plugin {
   };
 }
 
-export default defineConfig({
-  plugins: [modelsDir()],
-  server: { headers: isolationHeaders, port: 5173, strictPort: false },
-  preview: { headers: isolationHeaders, port: 4173, strictPort: false },
-  build: {
-    target: 'es2022',
-    sourcemap: true,
-    chunkSizeWarningLimit: 1024,
-    // dev/parity.html, dev/live.html, dev/long.html and dev/bench.html serve the parity tests (tests/e2e/engine-parity.spec.ts) and `npm run bench`.
-    rolldownOptions: {
-      input: {
-        main: resolve(import.meta.dirname, 'index.html'),
-        parity: resolve(import.meta.dirname, 'dev/parity.html'),
-        bench: resolve(import.meta.dirname, 'dev/bench.html'),
-        live: resolve(import.meta.dirname, 'dev/live.html'),
-        long: resolve(import.meta.dirname, 'dev/long.html'),
+/**
+ * `vite build` builds the app (index.html) into dist/. `vite build --mode test` (npm run build:test, after it) adds
+ * the test-only pages under dist/dev/ (parity, bench, live, long): the tests and `npm run bench` use them; the
+ * shipped app does not carry them.
+ */
+export default defineConfig(({ mode }) => {
+  const testPages = mode === 'test';
+  const page = (name: string) => resolve(import.meta.dirname, name);
+  return {
+    plugins: [modelsDir()],
+    server: { headers: isolationHeaders, port: 5173, strictPort: false },
+    preview: { headers: isolationHeaders, port: 4173, strictPort: false },
+    build: {
+      target: 'es2022',
+      sourcemap: true,
+      chunkSizeWarningLimit: 1024,
+      emptyOutDir: !testPages,
+      rolldownOptions: {
+        input: (testPages
+          ? { parity: page('dev/parity.html'), bench: page('dev/bench.html'), live: page('dev/live.html'), long: page('dev/long.html') }
+          : { main: page('index.html') }) as Record<string, string>,
       },
     },
-  },
-  optimizeDeps: { exclude: ['onnxruntime-web'] },
-  // The "extern wasm" build of onnxruntime-web (see ORT_FILES above) instead of the one with the wasm glue inlined:
-  // inlined, its thread workers import the bundle's chunk, which here imports a page entry ("document is not defined").
-  resolve: { conditions: ['onnxruntime-web-use-extern-wasm', ...defaultClientConditions] },
+    optimizeDeps: { exclude: ['onnxruntime-web'] },
+    // The "extern wasm" build of onnxruntime-web (see ORT_FILES above) instead of the one with the wasm glue inlined:
+    // inlined, its thread workers import the bundle's chunk, which here imports a page entry ("document is not defined").
+    resolve: { conditions: ['onnxruntime-web-use-extern-wasm', ...defaultClientConditions] },
+  };
 });

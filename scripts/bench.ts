@@ -16,6 +16,7 @@ import { decodeTemplate } from '../src/template/face-template';
 import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
+import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -37,10 +38,8 @@ async function nodeBench(): Promise<Record<string, number | string>> {
   const manifest = checkManifest(JSON.parse(readFileSync(resolve(models, 'manifest.json'), 'utf8')));
   const template = await decodeTemplate(JSON.parse(readFileSync(resolve(models, manifest.template.path), 'utf8')), bytes(manifest.template.path.replace('.json', '.bin')));
   const m = manifest.model.config;
-  const weights = decoderWeights(parseSafetensors(bytes(manifest.files.decoder_weights)).tensors, m);
-  const wav = readFileSync(resolve(ROOT, 'tests/fixtures/speech-kal.wav'));
-  const pcm = new Int16Array(wav.buffer.slice(wav.byteOffset + 44, wav.byteOffset + wav.byteLength - ((wav.byteLength - 44) % 2)));
-  const samples = Float32Array.from(pcm, (v) => v / 32768);
+  const weights = decoderWeights(parseSafetensors(bytes(manifest.files.decoder_weights)).tensors, m, manifest.model.layer_norm_eps);
+  const samples = readWav16(SPEECH);
   const seconds = samples.length / manifest.audio.sample_rate;
   const time = (fn: () => void, reps = 3) => {
     fn();
@@ -72,7 +71,7 @@ async function main(): Promise<void> {
     console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
     return;
   }
-  execSync('npm run --silent build', { cwd: ROOT, stdio: 'inherit' });
+  execSync('npm run --silent build:test', { cwd: ROOT, stdio: 'inherit' });
   const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
   try {
     for (let i = 0; ; i++) {

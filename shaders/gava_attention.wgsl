@@ -3,9 +3,11 @@
 // Tokens 0..N-1 are vertices (they attend to themselves and their 1-ring, from CSR lists);
 // token N is the pose token (it attends to every token). Same maths as src/attention/reference.ts.
 
-override D: u32 = 64u;        // d_model; also the workgroup size (a power of two, for the reductions)
-override HEADS: u32 = 4u;
-override FFN: u32 = 128u;     // feed-forward width, at most MAX_FFN
+override D: u32;        // d_model; also the workgroup size (a power of two, for the reductions)
+override HEADS: u32;
+override FFN: u32;     // feed-forward width, at most MAX_FFN
+override LN_EPS: f32;  // LayerNorm epsilon
+// (every override comes from models/manifest.json: model.config and model.layer_norm_eps; none has a default)
 const MAX_FFN: u32 = 512u;
 const MAX_D: u32 = 256u;
 
@@ -68,7 +70,7 @@ fn layer_norm(i: u32, xi: f32, g: u32, b: u32) {
   let mean = workgroup_sum(i, xi) / f32(D);
   let dev = xi - mean;
   let variance = workgroup_sum(i, dev * dev) / f32(D);
-  hbuf[i] = dev * inverseSqrt(variance + 1e-5) * weights[g + i] + weights[b + i];
+  hbuf[i] = dev * inverseSqrt(variance + LN_EPS) * weights[g + i] + weights[b + i];
   workgroupBarrier();
 }
 

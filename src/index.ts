@@ -1,7 +1,7 @@
 /**
  * The library: audio in, animated face out, all in the browser. See docs/engine.md.
  *
- *   const engine = await TalkingFaceEngine.load({ manifestUrl: '/models/manifest.json' });
+ *   const engine = await TalkingFaceEngine.load();                   // the model at /models/manifest.json
  *   const audio = await decodeAudio(file, engine.manifest.audio.sample_rate);
  *   const animation = await engine.animate(audio.samples);          // offline, in chunks
  *   const live = await engine.listen(await openMicrophone(), (first, frames) => draw(frames));
@@ -12,9 +12,11 @@ export { LiveSession, type LiveOptions } from './engine/live';
 export { decodeAudio, levels, AudioDecodeError, type DecodedAudio } from './audio/decode';
 export { openMicrophone, AudioCapture, StreamResampler, MicrophoneError, type CaptureOptions } from './audio/capture';
 export { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from './audio/mel';
-export { ModelLoadError, type ExecutionProvider } from './model/onnx-sessions';
-export { checkManifest, frameToMelIndex, type Manifest } from './model/manifest';
-export { ReferenceDecoder, applyPose, decoderWeights, type DecoderWeights, type DecodeResult } from './attention/reference';
+export { ModelLoadError } from './model/artefacts';
+export type { ExecutionProvider } from './encoders/onnx-model';
+export { checkManifest, frameToMelIndex, DEFAULT_MANIFEST_URL, type Manifest } from './model/manifest';
+export { ReferenceDecoder, decoderWeights, type DecoderWeights, type DecodeResult } from './attention/reference';
+export { applyPose } from './pose/posing';
 export { FastDecoder } from './attention/fast-decoder';
 export { GpuDecoder } from './attention/gpu-decoder';
 export { detectWebGPU } from './gpu/capabilities';

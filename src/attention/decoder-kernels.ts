@@ -1,6 +1,6 @@
 /**
  * The arithmetic of the fast CPU decoder (fast-decoder.ts), twice: in TypeScript (jsKernel) and in
- * WebAssembly SIMD (SimdKernel, simd/decoder.wat, four float lanes). The decoder is written once
+ * WebAssembly SIMD (SimdKernel in simd-kernel.ts, simd/decoder.wat, four float lanes). The decoder is written once
  * against the DecoderKernel interface and runs on either; tests hold both to the readable
  * ReferenceDecoder and to PyTorch.
  *
@@ -8,7 +8,6 @@
  * once up front (growing it would detach every view), holding the weights (transposed, so four
  * consecutive outputs are one vector load), the key lists, the GELU table and the buffers.
  */
-import { WASM_BASE64 } from './simd/decoder-wasm';
 
 /** A weight matrix (outs x cols, row-major) and bias, in the layout a kernel wants. */
 export interface PackedWeight {
@@ -31,7 +30,7 @@ export interface DecoderKernel {
   pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight;
   /** out[t, o] = b[o] + sum_i W[o, i] X[t, i] for t < rows (rows even for SIMD). */
   matmul(w: PackedWeight, X: Float32Array, rows: number, out: Float32Array): void;
-  layerNorm(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array): void;
+  layerNorm(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, eps: number): void;
   attention(qkv: Float32Array, tokens: number, d: number, heads: number, keyStart: Int32Array, keyIndex: Int32Array,
     scores: Float64Array, out: Float32Array): void;
   gelu(a: Float32Array, count: number): void;
@@ -81,10 +80,8 @@ export function matmulRows(W: Float32Array, b: Float32Array, outs: number, cols:
   }
 }
 
-const LN_EPS = 1e-5;
-
 /** Row-wise LayerNorm of X (rows x d) into out. */
-export function layerNormRows(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array): void {
+export function layerNormRows(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, eps: number): void {
   for (let t = 0; t < rows; t++) {
     const o = t * d;
     let mean = 0;
@@ -95,14 +92,14 @@ export function layerNormRows(X: Float32Array, rows: number, d: number, g: Float
       const c = X[o + i] - mean;
       v += c * c;
     }
-    const inv = 1 / Math.sqrt(v / d + LN_EPS);
+    const inv = 1 / Math.sqrt(v / d + eps);
     for (let i = 0; i < d; i++) out[o + i] = (X[o + i] - mean) * inv * g[i] + b[i];
   }
 }
 
 // GELU table: x/2 (1 + erf(x / sqrt 2)) and its derivative at GELU_STEPS points per unit on [-GELU_RANGE, GELU_RANGE].
-const GELU_RANGE = 8;
-const GELU_STEPS = 128;
+export const GELU_RANGE = 8;
+export const GELU_STEPS = 128;
 const SIZE = 2 * GELU_RANGE * GELU_STEPS + 1;
 let geluTable: { value: Float64Array; slope: Float64Array } | null = null;
 
@@ -219,128 +216,3 @@ export const jsKernel: DecoderKernel = {
     for (let i = 0; i < count; i++) x[i] += y[i];
   },
 };
-
-let module: WebAssembly.Module | null | undefined;
-
-/** The compiled SIMD module, or null where this runtime has no WebAssembly SIMD. */
-export function simdModule(): WebAssembly.Module | null {
-  if (module !== undefined) return module;
-  module = null;
-  if (typeof WebAssembly !== 'object') return module;
-  const bin = atob(WASM_BASE64);
-  const bytes = new Uint8Array(bin.length);
-  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
-  try {
-    if (WebAssembly.validate(bytes)) module = new WebAssembly.Module(bytes);
-  } catch {
-    module = null; // e.g. a Content-Security-Policy without 'wasm-unsafe-eval': the TypeScript kernel runs
-  }
-  return module;
-}
-
-interface SimdExports {
-  memory: WebAssembly.Memory;
-  matmul(wt: number, b: number, outs: number, cols: number, x: number, rows: number, out: number): void;
-  layer_norm(x: number, rows: number, d: number, g: number, b: number, out: number): void;
-  attention(qkv: number, tokens: number, d: number, heads: number, keyStart: number, keyIndex: number, scores: number, out: number, scale: number): void;
-  gelu(a: number, count: number, value: number, slope: number, range: number, steps: number): void;
-  add(x: number, y: number, count: number): void;
-}
-
-/** The SIMD kernel over one memory of `bytes` bytes (everything alloc'd, placed and packed, plus alignment). */
-export class SimdKernel implements DecoderKernel {
-  readonly name = 'wasm-simd';
-  private readonly exports: SimdExports;
-  private used = 0;
-  private readonly capacity: number;
-  private readonly geluValue: Float64Array;
-  private readonly geluSlope: Float64Array;
-
-  constructor(bytes: number) {
-    const mod = simdModule();
-    if (!mod) throw new Error('WebAssembly SIMD is not available in this runtime');
-    this.exports = new WebAssembly.Instance(mod).exports as unknown as SimdExports;
-    const table = geluTableData();
-    const need = bytes + 16 * table.value.length + 4096;
-    const have = this.exports.memory.buffer.byteLength;
-    if (need > have) this.exports.memory.grow(Math.ceil((need - have) / 65536));
-    this.capacity = this.exports.memory.buffer.byteLength;
-    this.geluValue = this.take(Float64Array, table.value.length);
-    this.geluValue.set(table.value);
-    this.geluSlope = this.take(Float64Array, table.slope.length);
-    this.geluSlope.set(table.slope);
-  }
-
-  private take<A extends Float32Array | Int32Array | Float64Array>(kind: { new (b: ArrayBuffer, o: number, n: number): A; BYTES_PER_ELEMENT: number }, length: number): A {
-    const start = (this.used + 15) & ~15; // 16-byte aligned: one vector
-    if (start + length * kind.BYTES_PER_ELEMENT > this.capacity) throw new Error(`SimdKernel: ${length} values more than reserved`);
-    this.used = start + length * kind.BYTES_PER_ELEMENT;
-    return new kind(this.exports.memory.buffer, start, length);
-  }
-
-  alloc(length: number): Float32Array {
-    return this.take(Float32Array, length);
-  }
-
-  place(values: Float32Array): Float32Array {
-    const a = this.take(Float32Array, values.length);
-    a.set(values);
-    return a;
-  }
-
-  placeInts(values: Int32Array): Int32Array {
-    const a = this.take(Int32Array, values.length);
-    a.set(values);
-    return a;
-  }
-
-  scratch(length: number): Float64Array {
-    return this.take(Float64Array, length);
-  }
-
-  pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight {
-    if (outs % 4) return { outs, cols, w: W, b }; // matmul() uses the TypeScript product for these
-    const w = this.alloc(outs * cols);
-    for (let o = 0; o < outs; o++) for (let i = 0; i < cols; i++) w[i * outs + o] = W[o * cols + i];
-    return { outs, cols, w, b: this.place(b) };
-  }
-
-  private mine(...arrays: ArrayBufferView[]): void {
-    for (const a of arrays) {
-      if (a.buffer !== this.exports.memory.buffer) throw new Error('SimdKernel: an array not allocated by this kernel');
-    }
-  }
-
-  matmul(p: PackedWeight, X: Float32Array, rows: number, out: Float32Array): void {
-    if (p.outs % 4) {
-      matmulRows(p.w, p.b, p.outs, p.cols, X, rows, out);
-      return;
-    }
-    if (rows % 2) throw new Error('SimdKernel.matmul: rows must be even');
-    this.mine(X, out);
-    this.exports.matmul(p.w.byteOffset, p.b.byteOffset, p.outs, p.cols, X.byteOffset, rows, out.byteOffset);
-  }
-
-  layerNorm(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array): void {
-    this.mine(X, g, b, out);
-    this.exports.layer_norm(X.byteOffset, rows, d, g.byteOffset, b.byteOffset, out.byteOffset);
-  }
-
-  attention(qkv: Float32Array, tokens: number, d: number, heads: number, keyStart: Int32Array, keyIndex: Int32Array,
-    scores: Float64Array, out: Float32Array): void {
-    if ((d / heads) % 4) throw new Error('SimdKernel.attention: the head size must be a multiple of 4');
-    this.mine(qkv, keyStart, keyIndex, scores, out);
-    this.exports.attention(qkv.byteOffset, tokens, d, heads, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset,
-      out.byteOffset, 1 / Math.sqrt(d / heads));
-  }
-
-  gelu(a: Float32Array, count: number): void {
-    this.mine(a);
-    this.exports.gelu(a.byteOffset, count, this.geluValue.byteOffset, this.geluSlope.byteOffset, GELU_RANGE, GELU_STEPS);
-  }
-
-  add(x: Float32Array, y: Float32Array, count: number): void {
-    this.mine(x, y);
-    this.exports.add(x.byteOffset, y.byteOffset, count);
-  }
-}

@@ -15,7 +15,8 @@
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
 import { keyLists, type DecodeResult, type DecoderWeights } from './reference';
-import { geluInPlace, jsKernel, matmulRows, simdModule, SimdKernel, type DecoderKernel, type PackedWeight } from './decoder-kernels';
+import { geluInPlace, jsKernel, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
+import { simdModule, SimdKernel } from './simd-kernel';
 
 export { geluInPlace, matmulRows };
 
@@ -111,12 +112,12 @@ export class FastDecoder {
 
   private layer(L: PackedLayer): void {
     const { d, x, h, qkv, attn, hidden, kernel: k, tokens: T, rows } = this;
-    k.layerNorm(x, T, d, L.ln1g, L.ln1b, h);
+    k.layerNorm(x, T, d, L.ln1g, L.ln1b, h, this.weights.lnEps);
     k.matmul(L.qkv, h, rows, qkv);
     k.attention(qkv, T, d, this.m.heads, this.keyStart, this.keyIndex, this.scores, attn);
     k.matmul(L.out, attn, rows, h);
     k.add(x, h, T * d);
-    k.layerNorm(x, T, d, L.ln2g, L.ln2b, h);
+    k.layerNorm(x, T, d, L.ln2g, L.ln2b, h, this.weights.lnEps);
     k.matmul(L.ffn1, h, rows, hidden);
     k.gelu(hidden, T * this.m.ffn);
     k.matmul(L.ffn2, hidden, rows, attn);
@@ -126,7 +127,7 @@ export class FastDecoder {
   private heads(offsets: Float32Array, pose: Float32Array, f: number): void {
     const { n, d, x, h, raw } = this;
     const w = this.weights;
-    this.kernel.layerNorm(x, this.tokens, d, this.lnG, this.lnB, h);
+    this.kernel.layerNorm(x, this.tokens, d, this.lnG, this.lnB, h, this.weights.lnEps);
     matmulRows(w.dispW, w.dispB, 3, d, h, n, offsets.subarray(f * n * 3, (f + 1) * n * 3));
     matmulRows(w.poseW, w.poseB, 6, d, h.subarray(n * d), 1, raw);
     for (let i = 0; i < 3; i++) pose[f * 6 + i] = this.m.max_rotation * Math.tanh(raw[i]);

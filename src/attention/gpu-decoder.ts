@@ -98,7 +98,7 @@ export class GpuDecoder {
       ],
     });
     const pipelineLayout = device.createPipelineLayout({ label: 'GpuDecoder.pipelineLayout', bindGroupLayouts: [layout] });
-    const constants = { D: d, HEADS: m.heads, FFN: m.ffn };
+    const constants = { D: d, HEADS: m.heads, FFN: m.ffn, LN_EPS: weights.lnEps };
     const pipeline = (entryPoint: string) =>
       device.createComputePipeline({ label: `GpuDecoder.${entryPoint}`, layout: pipelineLayout, compute: { module, entryPoint, constants } });
     this.pipelines = { ln_qkv: pipeline('ln_qkv'), attend: pipeline('attend'), out_ffn: pipeline('out_ffn'), heads: pipeline('heads') };
@@ -128,7 +128,7 @@ export class GpuDecoder {
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
     const run = this.busy.then(() => this.run(tokens, poseToken, frames));
     // Deliberate: the caller receives the run's error through `run`; `busy` only orders the runs.
-    this.busy = run.catch(() => undefined);
+    this.busy = run.catch(() => undefined); // the caller gets the error through `run`; `busy` only orders runs
     return run;
   }
 

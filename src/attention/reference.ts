@@ -11,8 +11,6 @@ import { f32, type Tensor } from '../model/safetensors';
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
 
-const LN_EPS = 1e-5;
-
 export interface LayerWeights {
   ln1g: Float32Array; ln1b: Float32Array;
   qkvW: Float32Array; qkvB: Float32Array; // (3d x d), (3d)
@@ -27,10 +25,13 @@ export interface DecoderWeights {
   lnG: Float32Array; lnB: Float32Array;
   dispW: Float32Array; dispB: Float32Array; // (3 x d)
   poseW: Float32Array; poseB: Float32Array; // (6 x d)
+  /** The LayerNorms' epsilon (manifest.model.layer_norm_eps). */
+  lnEps: number;
 }
 
 /** Pick the decoder's tensors out of gava.safetensors, checking every shape against the model constants. */
-export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants): DecoderWeights {
+/** `eps`: the LayerNorms' epsilon (manifest.model.layer_norm_eps). */
+export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants, eps: number): DecoderWeights {
   const d = m.d_model;
   const layers: LayerWeights[] = [];
   for (let i = 0; i < m.layers; i++) {
@@ -49,6 +50,7 @@ export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants): Decod
     lnG: f32(t, 'decoder.ln.weight', [d]), lnB: f32(t, 'decoder.ln.bias', [d]),
     dispW: f32(t, 'displacement_head.weight', [3, d]), dispB: f32(t, 'displacement_head.bias', [3]),
     poseW: f32(t, 'pose_head.weight', [6, d]), poseB: f32(t, 'pose_head.bias', [6]),
+    lnEps: eps,
   };
 }
 
@@ -66,13 +68,13 @@ export function gelu(x: number): number {
   return 0.5 * x * (1 + erf(x * Math.SQRT1_2));
 }
 
-function layerNorm(x: Float32Array, off: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, outOff: number): void {
+function layerNorm(x: Float32Array, off: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, outOff: number, eps: number): void {
   let mean = 0;
   for (let i = 0; i < d; i++) mean += x[off + i];
   mean /= d;
   let v = 0;
   for (let i = 0; i < d; i++) v += (x[off + i] - mean) ** 2;
-  const inv = 1 / Math.sqrt(v / d + LN_EPS);
+  const inv = 1 / Math.sqrt(v / d + eps);
   for (let i = 0; i < d; i++) out[outOff + i] = (x[off + i] - mean) * inv * g[i] + b[i];
 }
 
@@ -191,7 +193,7 @@ export class ReferenceDecoder {
     const dk = d / heads;
     const scale = 1 / Math.sqrt(dk);
     for (let t = 0; t < T; t++) {
-      layerNorm(x, t * d, d, L.ln1g, L.ln1b, h, t * d);
+      layerNorm(x, t * d, d, L.ln1g, L.ln1b, h, t * d, this.weights.lnEps);
       linear(L.qkvW, L.qkvB, 3 * d, d, h, t * d, qkv, t * 3 * d);
     }
     const { offsets: ro, indices: ri } = this.adjacency;
@@ -231,7 +233,7 @@ export class ReferenceDecoder {
     for (let t = 0; t < T; t++) {
       linear(L.outW, L.outB, d, d, attn, t * d, h, t * d);
       for (let i = 0; i < d; i++) x[t * d + i] += h[t * d + i];
-      layerNorm(x, t * d, d, L.ln2g, L.ln2b, h, t * d);
+      layerNorm(x, t * d, d, L.ln2g, L.ln2b, h, t * d, this.weights.lnEps);
       linear(L.ffn1W, L.ffn1B, this.m.ffn, d, h, t * d, this.hidden, 0);
       for (let i = 0; i < this.m.ffn; i++) this.hidden[i] = gelu(this.hidden[i]);
       linear(L.ffn2W, L.ffn2B, d, this.m.ffn, this.hidden, 0, attn, t * d);
@@ -242,37 +244,11 @@ export class ReferenceDecoder {
   private heads(offsets: Float32Array, pose: Float32Array, f: number): void {
     const { n, d, x, h } = this;
     const w = this.weights;
-    for (let t = 0; t <= n; t++) layerNorm(x, t * d, d, w.lnG, w.lnB, h, t * d);
+    for (let t = 0; t <= n; t++) layerNorm(x, t * d, d, w.lnG, w.lnB, h, t * d, w.lnEps);
     for (let j = 0; j < n; j++) linear(w.dispW, w.dispB, 3, d, h, j * d, offsets, (f * n + j) * 3);
     const raw = new Float32Array(6);
     linear(w.poseW, w.poseB, 6, d, h, n * d, raw, 0);
     for (let i = 0; i < 3; i++) pose[f * 6 + i] = this.m.max_rotation * Math.tanh(raw[i]);
     for (let i = 3; i < 6; i++) pose[f * 6 + i] = this.m.max_translation_mm * Math.tanh(raw[i]);
   }
-}
-
-/** y = R (I + O) + t (Eq. 2): template (N x 3) mm, offsets (F x N x 3), pose (F x 6) -> (F x N x 3). Rodrigues' formula. */
-export function applyPose(template: Float32Array, offsets: Float32Array, pose: Float32Array, frames: number, out?: Float32Array): Float32Array {
-  const n = template.length / 3;
-  const y = out ?? new Float32Array(frames * n * 3);
-  for (let f = 0; f < frames; f++) {
-    const [rx, ry, rz, tx, ty, tz] = pose.subarray(f * 6, f * 6 + 6);
-    const th = Math.hypot(rx, ry, rz);
-    const a = th < 1e-6 ? 1 - (th * th) / 6 : Math.sin(th) / th;
-    const b = th < 1e-6 ? 0.5 - (th * th) / 24 : (1 - Math.cos(th)) / (th * th);
-    // R = I + a K + b K^2, K the cross-product matrix of (rx, ry, rz).
-    const R = [
-      1 - b * (ry * ry + rz * rz), -a * rz + b * rx * ry, a * ry + b * rx * rz,
-      a * rz + b * rx * ry, 1 - b * (rx * rx + rz * rz), -a * rx + b * ry * rz,
-      -a * ry + b * rx * rz, a * rx + b * ry * rz, 1 - b * (rx * rx + ry * ry),
-    ];
-    for (let j = 0; j < n; j++) {
-      const o = (f * n + j) * 3;
-      const px = template[3 * j] + offsets[o], py = template[3 * j + 1] + offsets[o + 1], pz = template[3 * j + 2] + offsets[o + 2];
-      y[o] = R[0] * px + R[1] * py + R[2] * pz + tx;
-      y[o + 1] = R[3] * px + R[4] * py + R[5] * pz + ty;
-      y[o + 2] = R[6] * px + R[7] * py + R[8] * pz + tz;
-    }
-  }
-  return y;
 }

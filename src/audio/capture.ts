@@ -162,10 +162,16 @@ export class AudioCapture {
     try {
       context = new AudioContext({ sampleRate, latencyHint: 'interactive' });
       source = context.createMediaStreamSource(stream);
-    } catch {
-      // Some browsers cannot connect a stream to a context at another rate: run at the device's rate.
-      context = new AudioContext({ latencyHint: 'interactive' });
-      source = context.createMediaStreamSource(stream);
+    } catch (atModelRate) {
+      // Some browsers cannot connect a stream to a context at another rate: run at the device's rate (and
+      // resample); if that fails too, both reasons are reported.
+      try {
+        context = new AudioContext({ latencyHint: 'interactive' });
+        source = context.createMediaStreamSource(stream);
+      } catch (e) {
+        throw new Error(`the microphone could not be connected to the audio system (at ${sampleRate} Hz: ${(atModelRate as Error).message}; ` +
+          `at the device's rate: ${(e as Error).message})`);
+      }
     }
     const rate = context.sampleRate;
     const block = Math.max(128, Math.round(((options.block ?? 256) * rate) / sampleRate));
@@ -223,6 +229,6 @@ export class AudioCapture {
     this.node.disconnect();
     if (releaseStream) for (const t of this.stream.getTracks()) t.stop();
     // Deliberate: closing can only fail on a context that is already closed, which is the goal.
-    await this.context.close().catch(() => undefined);
+    await this.context.close().catch(() => undefined); // fails only on a context already closed: the goal
   }
 }

@@ -13,10 +13,13 @@
 import { FaceView } from '../render/face-view';
 import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { decodeAudio, levels } from '../audio/decode';
+import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
+import { DEFAULT_MANIFEST_URL } from '../model/manifest';
+import { Player, audioNotes } from '../player/player';
 
-export const DEFAULT_MODEL = '/models/manifest.json';
+/** The model an element loads when it has no `model` attribute. */
+export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 
 export interface ReadyDetail {
   backend: Backend;
@@ -53,7 +56,8 @@ function sharedEngine(model: string, template: string | null, backend: string): 
   if (!p) {
     p = TalkingFaceEngine.load({ manifestUrl: model, templateUrl: template ?? undefined, backend: backend as 'auto' | Backend });
     engines.set(key, p);
-    p.catch(() => engines.delete(key)); // a failed load can be retried
+    // Forget a failed load so a later element can retry it; the failure itself reaches the caller through `p`.
+    p.catch(() => engines.delete(key));
   }
   return p;
 }
@@ -67,23 +71,15 @@ canvas:focus-visible { box-shadow: inset 0 0 0 3px #7ab8ff; }
 :host([hide-status]) .status:not(.error) { display: none; }
 `;
 
-interface Playback {
-  context: AudioContext;
-  source: AudioBufferSourceNode;
-  startedAt: number;
-  done: () => void;
-}
-
 export class TalkingFaceElement extends HTMLElement {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live'];
 
   private readonly canvas: HTMLCanvasElement;
   private readonly statusLine: HTMLParagraphElement;
   private view: FaceView | null = null;
+  private player: Player | null = null;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
-  private audioContext: AudioContext | null = null;
-  private playback: Playback | null = null;
   private live: LiveSession | null = null;
   private animation: Animation | null = null;
   private computeMs = 0;
@@ -125,16 +121,16 @@ export class TalkingFaceElement extends HTMLElement {
   connectedCallback(): void {
     void this.load().then(
       () => this.afterLoad(),
-      () => undefined, // reported by load()
+      () => undefined, // deliberate: load() has already reported the failure (status line and `error` event)
     );
   }
 
   disconnectedCallback(): void {
     this.stop();
+    this.player?.dispose();
+    this.player = null;
     this.view?.dispose();
     this.view = null;
-    void this.audioContext?.close();
-    this.audioContext = null;
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
@@ -143,9 +139,11 @@ export class TalkingFaceElement extends HTMLElement {
       this.stop();
       this.loading = null;
       this.engine = null;
+      this.player?.dispose();
+      this.player = null;
       this.view?.dispose();
       this.view = null;
-      void this.load().then(() => this.afterLoad(), () => undefined);
+      void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'backend' && this.engine && value) {
       this.engine.setBackend(value === 'auto' ? (this.engine.backend) : (value as Backend)).then(
         () => this.setStatus(`Decoder: ${this.engine!.backend}.`),
@@ -153,7 +151,7 @@ export class TalkingFaceElement extends HTMLElement {
       );
     } else if (name === 'src' && value && this.engine) {
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
-      void this.speak(value).catch(() => undefined);
+      void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
     } else if (name === 'live' && this.engine) {
       if (value !== null) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
       else this.stop();
@@ -185,7 +183,8 @@ export class TalkingFaceElement extends HTMLElement {
       throw this.fail('audio', `the audio could not be read: ${(e as Error).message}`);
     }
     if (gen !== this.generation) return;
-    const lv = levels(decoded.samples);
+    const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
+    const notes = audioNotes(decoded.samples, seconds);
     const t0 = performance.now();
     let animation: Animation;
     try {
@@ -198,15 +197,13 @@ export class TalkingFaceElement extends HTMLElement {
     }
     if (gen !== this.generation) return;
     this.computeMs = performance.now() - t0;
-    this.audioSeconds = decoded.samples.length / engine.manifest.audio.sample_rate;
+    this.audioSeconds = seconds;
     this.animation = animation;
-    this.showFrame(0);
-    const notes = [];
-    if (lv.peak < 1e-3) notes.push('the audio is silent');
-    if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of it is clipped`);
+    this.player?.load(animation, decoded.buffer);
+    this.player?.show(0);
     this.setStatus(`${animation.frames} frames, ${(this.audioSeconds / (this.computeMs / 1000)).toFixed(1)}x real time on ${engine.backend}` +
       (notes.length ? ` (${notes.join('; ')})` : ''));
-    await this.play(decoded.buffer, gen);
+    await this.player?.play(0);
   }
 
   /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
@@ -224,15 +221,11 @@ export class TalkingFaceElement extends HTMLElement {
       for (const t of media.getTracks()) t.stop();
       return;
     }
-    const n = engine.template.vertexCount;
     try {
       this.live = await engine.listen(media, (first: number, frames: Frames) => {
-        if (gen !== this.generation || !this.view) return;
+        if (gen !== this.generation || !this.player) return;
         const last = frames.count - 1;
-        this.view.setVertices(frames.unposed.subarray(last * n * 3, (last + 1) * n * 3));
-        const p = frames.pose.subarray(last * 6, last * 6 + 6);
-        const s = engine.unitsPerMm;
-        this.view.setPose(p[0], p[1], p[2], p[3] * s, p[4] * s, p[5] * s);
+        this.player.showLive(frames);
         const latency = this.live?.stream.latency;
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
           detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs },
@@ -248,17 +241,9 @@ export class TalkingFaceElement extends HTMLElement {
   /** Stop playback and the microphone. */
   stop(): void {
     this.generation++;
-    if (this.playback) {
-      const p = this.playback;
-      this.playback = null;
-      p.source.onended = null;
-      try {
-        p.source.stop();
-      } catch {
-        /* not started */
-      }
-      p.done();
-    }
+    const wasPlaying = this.player?.isPlaying ?? false;
+    this.player?.stop();
+    if (wasPlaying) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
     if (this.live) {
       const live = this.live;
       this.live = null;
@@ -289,6 +274,7 @@ export class TalkingFaceElement extends HTMLElement {
     if (!this.view) {
       try {
         this.view = new FaceView(this.canvas, engine.template);
+        this.player = new Player(this.view, engine.unitsPerMm, { onFrame: (f) => this.playbackFrame(f), onEnded: () => this.dispatchEvent(new CustomEvent('ended')) });
       } catch (e) {
         this.fail('model', `the face cannot be drawn here (WebGL unavailable?): ${(e as Error).message}`);
         return;
@@ -304,61 +290,20 @@ export class TalkingFaceElement extends HTMLElement {
     }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
-    if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined);
-    else if (src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined);
+    if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined); // reported by fail()
+    else if (src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined); // reported by fail()
   }
 
-  private play(buffer: AudioBuffer, gen: number): Promise<void> {
-    const engine = this.engine!;
-    this.audioContext ??= new AudioContext();
-    const context = this.audioContext;
-    void context.resume();
-    return new Promise<void>((resolve) => {
-      const source = context.createBufferSource();
-      source.buffer = buffer;
-      source.connect(context.destination);
-      const startedAt = context.currentTime + 0.05;
-      const done = () => {
-        resolve();
-        this.dispatchEvent(new CustomEvent('ended'));
-      };
-      this.playback = { context, source, startedAt, done };
-      source.onended = () => {
-        if (this.playback?.source === source) {
-          this.playback = null;
-          done();
-        }
-      };
-      source.start(startedAt);
-      let last = -1;
-      const tick = () => {
-        if (gen !== this.generation || !this.animation || this.playback?.source !== source) return;
-        const frame = Math.floor((context.currentTime - startedAt) * this.animation.fps);
-        if (frame !== last && frame >= 0 && frame < this.animation.frames) {
-          last = frame;
-          this.showFrame(frame);
-          this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
-            detail: {
-              frame, time: frame / this.animation.fps, mode: 'playback', backend: engine.backend,
-              inferenceMs: this.computeMs / this.animation.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
-            },
-          }));
-        }
-        requestAnimationFrame(tick);
-      };
-      requestAnimationFrame(tick);
-    });
-  }
-
-  private showFrame(frame: number): void {
+  /** A frame event for each frame shown while playing. */
+  private playbackFrame(frame: number): void {
     const a = this.animation;
-    if (!a?.unposed || !this.view || !this.engine) return;
-    const n = this.engine.template.vertexCount;
-    const f = Math.min(Math.max(0, frame), a.frames - 1);
-    this.view.setVertices(a.unposed.subarray(f * n * 3, (f + 1) * n * 3));
-    const p = a.pose;
-    const s = this.engine.unitsPerMm;
-    this.view.setPose(p[f * 6], p[f * 6 + 1], p[f * 6 + 2], p[f * 6 + 3] * s, p[f * 6 + 4] * s, p[f * 6 + 5] * s);
+    if (!a || !this.engine || !this.player?.isPlaying) return;
+    this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
+      detail: {
+        frame, time: frame / a.fps, mode: 'playback', backend: this.engine.backend,
+        inferenceMs: this.computeMs / a.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
+      },
+    }));
   }
 
   private setStatus(text: string, isError = false): void {

@@ -3,7 +3,7 @@
  * as the person speaks. The take is kept (mono, model rate) so it can be replayed or animated again.
  */
 import { AudioCapture, type CaptureOptions } from '../audio/capture';
-import type { Frames, StreamSession, TalkingFaceEngine } from './engine';
+import type { StreamSession } from './stream';
 
 export interface LiveOptions extends CaptureOptions {
   /** Keep the captured audio for replay (default true). A ten-minute take is 38 MB at 16 kHz. */
@@ -30,11 +30,16 @@ export class LiveSession {
     private readonly keepAudio: boolean,
   ) {}
 
-  static async start(engine: TalkingFaceEngine, media: MediaStream, onFrames: (first: number, frames: Frames) => void, options: LiveOptions = {}): Promise<LiveSession> {
-    const stream = engine.createStream(onFrames, { maxLagFrames: options.maxLagFrames ?? 15 });
+  /** Capture `media` into `stream` (made with maxLagFrames = LiveSession.maxLag(options): see LiveOptions). */
+  static async start(stream: StreamSession, media: MediaStream, options: LiveOptions = {}): Promise<LiveSession> {
     const session = new LiveSession(stream, null, options.keepAudio ?? true);
-    session.capture = await AudioCapture.start(media, engine.manifest.audio.sample_rate, (piece) => session.receive(piece, options.onError), options);
+    session.capture = await AudioCapture.start(media, stream.sampleRate, (piece) => session.receive(piece, options.onError), options);
     return session;
+  }
+
+  /** The stream's lag limit for live use (LiveOptions.maxLagFrames, default 15 frames). */
+  static maxLag(options: LiveOptions = {}): number {
+    return options.maxLagFrames ?? 15;
   }
 
   /** Seconds of audio captured so far. */

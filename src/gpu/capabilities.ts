@@ -64,6 +64,7 @@ export function requestSharedDevice(): Promise<GPUDevice> {
     });
     return device;
   })();
+  // Forget a failed request so the next call tries again; the caller receives the error through the returned promise.
   sharedDevice.catch(() => {
     sharedDevice = null;
   });

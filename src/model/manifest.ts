@@ -5,6 +5,9 @@
 
 export const MANIFEST_FORMAT = 'talking-face-model';
 
+/** Where the app, the element and the dev pages find the shipped model (models/ is served at /models/). */
+export const DEFAULT_MANIFEST_URL = '/models/manifest.json';
+
 export interface AudioConstants {
   sample_rate: number;
   frame_size: number;
@@ -34,13 +37,15 @@ export interface ModelConstants {
 export interface Manifest {
   format: typeof MANIFEST_FORMAT;
   version: number;
-  model: { name: string; config: ModelConstants; trained_steps: number; trained_minutes: number; parameters: number };
+  model: { name: string; config: ModelConstants; trained_steps: number; trained_minutes: number; parameters: number; layer_norm_eps: number };
   audio: AudioConstants;
   template: { id: string; units: string; vertices: number; path: string };
   files: Record<string, string>;
   runtime_files: string[];
   sha256: Record<string, string>;
   decoder_tensors: Record<string, number[]>;
+  /** Each ONNX file's inputs and outputs with their shapes (strings are free dimensions, e.g. "K"). */
+  onnx: Record<string, { inputs: Record<string, (number | string)[]>; outputs: Record<string, (number | string)[]> }>;
   fixtures: { file: string; frames: number; token_frames: number };
   /** Mel frames each encoder output reads after its own position (look-ahead) and before it (context). */
   receptive_field: { content_mel_frames: number; pose_mel_frames: number; content_mel_frames_back: number; pose_mel_frames_back: number };
@@ -65,6 +70,10 @@ export function checkManifest(m: unknown): Manifest {
   }
   for (const key of ['content_mel_frames', 'pose_mel_frames', 'content_mel_frames_back', 'pose_mel_frames_back'] as const) {
     if (!Number.isFinite(x.receptive_field?.[key])) throw new ManifestError(`model manifest lacks receptive_field.${key} (re-export the model)`);
+  }
+  if (!(x.model?.layer_norm_eps > 0)) throw new ManifestError('model manifest lacks model.layer_norm_eps (re-export the model)');
+  for (const key of x.runtime_files ?? []) {
+    if (key !== 'decoder_weights' && !x.onnx?.[key]?.inputs) throw new ManifestError(`model manifest lacks onnx.${key}.inputs (re-export the model)`);
   }
   return x;
 }

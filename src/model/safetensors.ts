@@ -1,7 +1,7 @@
 /**
  * Read the safetensors layout (https://huggingface.co/docs/safetensors): a little-endian u64
  * header length, a JSON header naming each tensor's dtype, shape and byte range, then the data.
- * The exporter (training/src/talkingface/export.py) writes the attention weights and the fixtures so.
+ * The exporter (training/src/talkingface/export.py, with fixtures.py for the fixtures) writes the attention weights and the fixtures so.
  */
 
 export type TensorData = Float32Array | Int32Array | BigInt64Array | Uint32Array;

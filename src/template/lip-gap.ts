@@ -1,5 +1,5 @@
 /**
- * The inner-lip gap as training measures it (training/src/talkingface/corpus/checks.py, contour_gap): the
+ * The inner-lip gap as training measures it (training/src/talkingface/geometry/contours.py, contour_gap): the
  * largest vertical opening between the upper inner-lip contour's vertices (the mouth corners excluded) and the
  * lower contour, interpolated in x below each of them. Template units; 0 = touching, below 0 = pressed together.
  */

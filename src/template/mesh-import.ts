@@ -108,7 +108,7 @@ export function parsePly(data: ArrayBuffer): RawMesh {
   if (format !== 'ascii' && format !== 'binary_little_endian') {
     throw new TemplateFormatError(`PLY format "${format}" is not supported (use ascii or binary_little_endian)`);
   }
-  const rows = format === 'ascii' ? readPlyAscii(bytes.subarray(headerEnd), elements) : readPlyBinary(data, headerEnd, elements);
+  const rows = readPlyRows(format === 'ascii' ? asciiReader(bytes.subarray(headerEnd)) : binaryReader(data, headerEnd), elements);
   const vertex = rows.get('vertex');
   const face = rows.get('face');
   if (!vertex || !face) throw new TemplateFormatError('PLY file needs "vertex" and "face" elements');
@@ -142,33 +142,22 @@ function findHeaderEnd(bytes: Uint8Array): number {
 
 type PlyRow = Record<string, number | number[]>;
 
-function readPlyAscii(body: Uint8Array, elements: PlyElement[]): Map<string, PlyRow[]> {
+/** The next scalar of a PLY body, read as `type` (binary) or as the next number token (ascii). */
+type PlyScalarReader = (type: string) => number;
+
+function asciiReader(body: Uint8Array): PlyScalarReader {
   const tokens = new TextDecoder().decode(body).split(/\s+/).filter(Boolean).map(Number);
   let p = 0;
-  const out = new Map<string, PlyRow[]>();
-  for (const el of elements) {
-    const rows: PlyRow[] = [];
-    for (let i = 0; i < el.count; i++) {
-      const row: PlyRow = {};
-      for (const prop of el.props) {
-        if (prop.countType) {
-          const n = tokens[p++];
-          row[prop.name] = tokens.slice(p, p + n);
-          p += n;
-        } else row[prop.name] = tokens[p++];
-      }
-      rows.push(row);
-    }
-    out.set(el.name, rows);
-  }
-  if (p > tokens.length) throw new TemplateFormatError('PLY file ends before all elements were read');
-  return out;
+  return () => {
+    if (p >= tokens.length) throw new TemplateFormatError('PLY file ends before all elements were read');
+    return tokens[p++];
+  };
 }
 
-function readPlyBinary(data: ArrayBuffer, start: number, elements: PlyElement[]): Map<string, PlyRow[]> {
+function binaryReader(data: ArrayBuffer, start: number): PlyScalarReader {
   const d = new DataView(data);
   let o = start;
-  const read = (type: string) => {
+  return (type) => {
     const t = PLY_TYPES[type];
     if (!t) throw new TemplateFormatError(`PLY property type "${type}" is not supported`);
     if (o + t.size > d.byteLength) throw new TemplateFormatError('PLY file ends before all elements were read');
@@ -176,6 +165,10 @@ function readPlyBinary(data: ArrayBuffer, start: number, elements: PlyElement[])
     o += t.size;
     return v;
   };
+}
+
+/** Every element's rows, each property (scalar or list) read in header order by `read`. */
+function readPlyRows(read: PlyScalarReader, elements: PlyElement[]): Map<string, PlyRow[]> {
   const out = new Map<string, PlyRow[]>();
   for (const el of elements) {
     const rows: PlyRow[] = [];

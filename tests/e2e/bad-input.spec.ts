@@ -1,5 +1,5 @@
 import { test, expect } from './fixtures';
-import { SPEECH, speechSamples, wav, resample, lipGaps } from './helpers/audio';
+import { FPS, SPEECH, speechSamples, wav, resample, lipGaps } from './helpers/audio';
 
 /** Inputs a visitor may bring: other rates, stereo, clipping, very long files, a broken or missing model. */
 test.describe('the demo with unusual audio', () => {
@@ -21,7 +21,7 @@ test.describe('the demo with unusual audio', () => {
       await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
       await expect(page.locator('#clip-info')).toContainText(info);
       const gaps = await lipGaps(page);
-      expect(Math.abs(gaps.length - Math.round(seconds * 30))).toBeLessThanOrEqual(1);
+      expect(Math.abs(gaps.length - Math.round(seconds * FPS))).toBeLessThanOrEqual(1);
       expect(Math.max(...gaps) - Math.min(...gaps)).toBeGreaterThan(2);
     });
   }

@@ -2,7 +2,7 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
 import { fakeMicrophone } from '../../playwright.config';
-import { readWav16 } from './helpers/audio';
+import { FPS, SAMPLE_RATE, readWav16 } from './helpers/audio';
 
 /**
  * The lips close on /p b m/ in the browser (issue 14): a test-split sample clip (an unseen voice, sentence and
@@ -24,7 +24,7 @@ test.use({ launchOptions: fakeMicrophone(WAV) });
 /** Offset (samples) into the looped clip at which the take begins: coarse at 2 kHz, refined at 16 kHz. */
 function offsetInLoop(take: number[], clipAudio: Float32Array): number {
   const L = clipAudio.length;
-  const start = Math.min(16000, Math.max(0, take.length - 16000));
+  const start = Math.min(SAMPLE_RATE, Math.max(0, take.length - SAMPLE_RATE));
   const score = (off: number, step: number, len: number) => {
     let s = 0;
     for (let t = 0; t < len; t += step) s += take[start + t] * clipAudio[(start + t + off) % L];
@@ -32,13 +32,13 @@ function offsetInLoop(take: number[], clipAudio: Float32Array): number {
   };
   let best = 0, bestScore = -Infinity;
   for (let off = 0; off < L; off += 8) {
-    const s = score(off, 8, 16000);
+    const s = score(off, 8, SAMPLE_RATE);
     if (s > bestScore) [best, bestScore] = [off, s];
   }
   let fine = best;
   bestScore = -Infinity;
   for (let off = best - 8; off <= best + 8; off++) {
-    const s = score((off + L) % L, 1, 16000);
+    const s = score((off + L) % L, 1, SAMPLE_RATE);
     if (s > bestScore) [fine, bestScore] = [(off + L) % L, s];
   }
   return fine;
@@ -51,7 +51,7 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
   const r = (await handle.jsonValue()) as { error?: string; contourGaps: number[]; take: number[]; mmPerUnit: number };
   expect(r.error, r.error).toBeUndefined();
   const audio = readWav16(WAV);
-  const fps = 30, sr = 16000;
+  const fps = FPS, sr = SAMPLE_RATE;
   const off = offsetInLoop(r.take, audio) / sr;
   const loop = audio.length / sr;
   const gaps = r.contourGaps.map((g) => g * r.mmPerUnit);

@@ -2,13 +2,13 @@ import { writeFileSync, mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
 import { fakeMicrophone } from '../../playwright.config';
-import { wav, lipGaps } from './helpers/audio';
+import { SAMPLE_RATE, wav, lipGaps } from './helpers/audio';
 
 /** A silent microphone (Chromium's fake device playing a silent WAV): the mouth stays closed. */
 const DIR = resolve(import.meta.dirname, '../../test-results');
 mkdirSync(DIR, { recursive: true });
 const SILENT = resolve(DIR, 'silence-16k.wav');
-writeFileSync(SILENT, wav([new Float32Array(16000 * 4)], 16000));
+writeFileSync(SILENT, wav([new Float32Array(SAMPLE_RATE * 4)], SAMPLE_RATE));
 
 test.use({ launchOptions: fakeMicrophone(SILENT) });
 

@@ -1,5 +1,5 @@
 import { test, expect, imageStats } from './fixtures';
-import { speechSamples, wav } from './helpers/audio';
+import { FPS, speechSamples, wav } from './helpers/audio';
 
 /**
  * What the paper shows, on a sample clip of the test split with its ground truth: error heat map (Fig. 5),
@@ -66,7 +66,7 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   expect(glb.info.morphTargets).toBe(take.frames);
   expect(glb.info.clips).toBe(1);
   expect(glb.info.vertices).toBe(468);
-  expect(glb.info.duration).toBeCloseTo((take.frames - 1) / 30, 3);
+  expect(glb.info.duration).toBeCloseTo((take.frames - 1) / FPS, 3);
 
   // Raw frames: float32 frames x N x 3.
   const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-raw').click()]);
@@ -96,7 +96,7 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.encoding).toBe('components');
   expect(glb.info.morphTargets).toBe(8);
   expect(glb.info.vertices).toBe(468);
-  expect(glb.info.duration).toBeCloseTo((frames - 1) / 30, 3);
+  expect(glb.info.duration).toBeCloseTo((frames - 1) / FPS, 3);
   expect(glb.bytes).toBeLessThan(1e6); // per-frame targets would be ~28 MB
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
   // The page says what it did.

@@ -1,6 +1,6 @@
 import { test, expect, imageStats } from './fixtures';
 import { fakeMicrophone } from '../../playwright.config';
-import { SPEECH, lipGaps } from './helpers/audio';
+import { FPS, SAMPLE_RATE, SPEECH, lipGaps } from './helpers/audio';
 
 /** The demo's Record button with Chromium's fake microphone playing tests/fixtures/speech-kal.wav. */
 test.use({ launchOptions: fakeMicrophone(SPEECH) });
@@ -23,16 +23,15 @@ test('record: the face follows the microphone live, then the take replays in syn
   expect(gaps.length).toBeGreaterThan(60);
   expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth opens and closes (mm)').toBeGreaterThan(2);
   // ... in time with the speech: the lip gap follows the loudness of the take (best over a lag of +-100 ms).
-  const envelope = await page.evaluate(() => {
+  const envelope = await page.evaluate((per) => {
     const take = (globalThis as unknown as { talkingFace: { take: { samples: Float32Array; animation: { frames: number } } } }).talkingFace.take;
-    const per = 16000 / 30;
     return Array.from({ length: take.animation.frames }, (_, f) => {
       let e = 0;
       const a = Math.max(0, Math.round((f - 0.5) * per)), b = Math.min(take.samples.length, Math.round((f + 0.5) * per));
       for (let i = a; i < b; i++) e += take.samples[i] ** 2;
       return Math.sqrt(e / Math.max(1, b - a));
     });
-  });
+  }, SAMPLE_RATE / FPS);
   const corr = (x: number[], y: number[]) => {
     const mx = x.reduce((s, v) => s + v, 0) / x.length, my = y.reduce((s, v) => s + v, 0) / y.length;
     let sxy = 0, sxx = 0, syy = 0;
@@ -48,6 +47,6 @@ test('record: the face follows the microphone live, then the take replays in syn
   await page.locator('#play-button').click();
   await expect(page.locator('#play-button')).toHaveText('Play');
   // Scrubbing shows the chosen frame.
-  await page.locator('#scrub').fill('30');
+  await page.locator('#scrub').fill(String(FPS));
   await expect(page.locator('#time-label')).toHaveText('1.00 s');
 });

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 
 from talkingface import samples
-
-MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
+from talkingface.data.datasets import open_dataset
+from talkingface.paths import MODELS_DIR
 
 
 def read_gt(path: Path, n: int, frames: int):
@@ -29,7 +29,6 @@ def test_committed_samples_match_their_index():
 
 
 def test_samples_round_trip_the_ground_truth(corpus, tmp_path):
-    from talkingface.data.datasets import open_dataset
     ds = open_dataset(corpus.root)
     key = ds.keys("test")[0]
     c = samples.write_sample(ds, key, tmp_path)

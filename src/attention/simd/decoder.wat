@@ -122,8 +122,8 @@
         (local.set $y (i32.add (local.get $y) (i32.const 4)))
         (br $one))))
 
-  ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps 1e-5), any d
-  (func $layer_norm_f64 (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+  ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps as given), any d
+  (func $layer_norm_f64 (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32) (param $eps f64)
     (local $t i32) (local $i i32) (local $row i32) (local $mean f64) (local $var f64) (local $c f64) (local $inv f64)
     (local $db i32)
     (local.set $db (i32.shl (local.get $d) (i32.const 2)))
@@ -149,7 +149,7 @@
           (local.set $i (i32.add (local.get $i) (i32.const 4)))
           (br_if $sq (i32.lt_u (local.get $i) (local.get $db))))
         (local.set $inv (f64.div (f64.const 1)
-          (f64.sqrt (f64.add (f64.div (local.get $var) (f64.convert_i32_u (local.get $d))) (f64.const 1e-5)))))
+          (f64.sqrt (f64.add (f64.div (local.get $var) (f64.convert_i32_u (local.get $d))) (local.get $eps)))))
         (local.set $i (i32.const 0))
         (loop $norm
           (f32.store (i32.add (local.get $out) (i32.add (local.get $row) (local.get $i)))
@@ -311,12 +311,12 @@
         (br $tokens_loop))))
 
   ;; Row-wise LayerNorm in float32 vectors: d a multiple of 4 (else the float64 version runs)
-  (func (export "layer_norm") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32)
+  (func (export "layer_norm") (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32) (param $eps f64)
     (local $t i32) (local $i i32) (local $row i32) (local $db i32) (local $acc v128) (local $mean v128) (local $c v128)
     (local $inv v128) (local $m f32) (local $v f32)
     (if (i32.and (local.get $d) (i32.const 3))
       (then
-        (call $layer_norm_f64 (local.get $x) (local.get $rows) (local.get $d) (local.get $g) (local.get $b) (local.get $out))
+        (call $layer_norm_f64 (local.get $x) (local.get $rows) (local.get $d) (local.get $g) (local.get $b) (local.get $out) (local.get $eps))
         (return)))
     (local.set $db (i32.shl (local.get $d) (i32.const 2)))
     (block $rows_done
@@ -345,7 +345,7 @@
           (f32.add (f32.add (f32x4.extract_lane 0 (local.get $acc)) (f32x4.extract_lane 1 (local.get $acc)))
                    (f32.add (f32x4.extract_lane 2 (local.get $acc)) (f32x4.extract_lane 3 (local.get $acc))))
           (f32.convert_i32_u (local.get $d))))
-        (local.set $inv (f32x4.splat (f32.div (f32.const 1) (f32.sqrt (f32.add (local.get $v) (f32.const 1e-5))))))
+        (local.set $inv (f32x4.splat (f32.div (f32.const 1) (f32.sqrt (f32.add (local.get $v) (f32.demote_f64 (local.get $eps)))))))
         (local.set $i (i32.const 0))
         (loop $norm
           (v128.store (i32.add (i32.add (local.get $out) (i32.mul (local.get $t) (local.get $db))) (local.get $i))

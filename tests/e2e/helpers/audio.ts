@@ -5,18 +5,24 @@ import type { Page } from '@playwright/test';
 
 export const SPEECH = resolve(import.meta.dirname, '../../fixtures/speech-kal.wav');
 
+/** The shipped model's numbers the tests need (models/manifest.json is their one source). */
+const MANIFEST = JSON.parse(readFileSync(resolve(import.meta.dirname, '../../../models/manifest.json'), 'utf8')) as { audio: { sample_rate: number; fps: number } };
+export const SAMPLE_RATE = MANIFEST.audio.sample_rate;
+export const FPS = MANIFEST.audio.fps;
+
 export function speechSamples(): { samples: Float32Array; rate: number } {
-  const b = readFileSync(SPEECH);
-  const n = (b.length - 44) >> 1;
-  const samples = new Float32Array(n);
-  for (let i = 0; i < n; i++) samples[i] = b.readInt16LE(44 + 2 * i) / 32768;
-  return { samples, rate: 16000 };
+  return { samples: readWav16(SPEECH), rate: SAMPLE_RATE };
 }
 
-/** A mono 16 kHz 16-bit PCM WAV file's samples (the corpus's and the sample clips' format), chunks walked to "data". */
+/** Frames the engine makes for a WAV file at `path` (round(duration * fps), as the engine counts them). */
+export function framesOf(path: string): number {
+  return Math.round((readWav16(path).length / SAMPLE_RATE) * FPS);
+}
+
+/** A mono 16-bit PCM WAV file's samples at the model's rate (the corpus's and the sample clips' format), chunks walked to "data". */
 export function readWav16(path: string): Float32Array {
   const b = readFileSync(path);
-  if (b.readUInt32LE(24) !== 16000 || b.readUInt16LE(34) !== 16 || b.readUInt16LE(22) !== 1) throw new Error(`${path}: expected 16 kHz mono 16-bit PCM`);
+  if (b.readUInt32LE(24) !== SAMPLE_RATE || b.readUInt16LE(34) !== 16 || b.readUInt16LE(22) !== 1) throw new Error(`${path}: expected mono 16-bit PCM at the model's ${SAMPLE_RATE} Hz`);
   let o = 12;
   while (b.toString('ascii', o, o + 4) !== 'data') o += 8 + b.readUInt32LE(o + 4);
   const n = b.readUInt32LE(o + 4) / 2;

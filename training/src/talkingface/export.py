@@ -10,9 +10,10 @@ Writes
   gava.safetensors       the attention layers and the heads (the browser's WGSL / TypeScript decoder reads these)
   gava_dense.onnx        the whole model with the dense (N+1)^2 mask, for parity checks only
   fixtures/              a short clip and every intermediate tensor, for the TypeScript tests
-  manifest.json          every shared constant, tensor names and shapes, the template id, file hashes
-The checkpoint given (weights and configs, no optimiser state) is copied to models/checkpoint.pt when
---out is models/, so the export can be rerun and checked byte for byte.
+  manifest.json          every shared constant, tensor names and shapes, the template id and units, file hashes
+The template is the one the checkpoint was trained on (train.checkpoint_template), or the one --template names;
+its units set the model's millimetres. The checkpoint given (weights and configs, no optimiser state) is copied to
+models/checkpoint.pt when --out is models/, so the export can be rerun and checked byte for byte.
 """
 from __future__ import annotations
 
@@ -27,13 +28,12 @@ import numpy as np
 import torch
 import torch.nn as nn
 
-from .data.datasets import read_wav
-from .corpus.phonemes import PHONES
-from .features import AudioConfig, frame_to_mel_index, log_mel
+from .fixtures import fixture_audio, write_fixtures
 from .model.gava import TalkingFace
-from .paths import MODELS_DIR, TEMPLATE_DIR
-from .safetensors import read_safetensors, sha256, write_safetensors
-from .template import load_template
+from .paths import MODELS_DIR
+from .phones import CONTENT_CLASSES
+from .safetensors import sha256, write_safetensors
+from .template import Template, load_template
 
 MANIFEST_FORMAT = "talking-face-model"
 OPSET = 17
@@ -69,6 +69,9 @@ class _Dense(nn.Module):
 
 
 def _onnx(module: nn.Module, args: tuple, path: Path, inputs: list[str], outputs: list[str], dynamic: dict) -> None:
+    # The TorchScript exporter warns that it is legacy (DeprecationWarning), that Python-level shape checks are traced
+    # as constants (TracerWarning), and about constant folding and LSTM batch sizes (UserWarning); whether the graphs
+    # compute what PyTorch does is tested instead (tests/test_export.py), at the shapes the browser uses.
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         buf = io.BytesIO()
@@ -114,67 +117,28 @@ def receptive_field(model: TalkingFace) -> dict:
     return reach
 
 
-FIXTURE_SECONDS = 0.6     # a short clip keeps the fixtures small
-FIXTURE_TOKEN_FRAMES = 2  # frames whose tokens and per-layer outputs are kept
+def layer_norm_eps(model: TalkingFace) -> float:
+    """The eps of the decoder's LayerNorms, read from the modules: the browser's decoder normalises with it."""
+    eps = {m.eps for m in model.decoder.modules() if isinstance(m, nn.LayerNorm)}
+    if len(eps) != 1:
+        raise ValueError(f"the decoder's LayerNorms use eps {sorted(eps)}; the manifest carries one")
+    return eps.pop()
 
 
-@torch.no_grad()
-def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path) -> dict:
-    """Every intermediate tensor of one short clip, from the same code paths the browser mirrors."""
-    a = model.audio
-    mel = log_mel(audio, a)                                                    # (K, n_mels)
-    n_frames = int(round(len(audio) / a.sample_rate * a.fps))
-    mel_t = torch.from_numpy(mel)[None]
-    logits = model.content(mel_t)                                              # (1, Kc, D)
-    mel_index = torch.from_numpy(frame_to_mel_index(np.arange(n_frames), a)).clamp(max=mel.shape[0] - 1)
-    windows = model.content_windows(logits, mel_index[None])[0]                # (F, W, D)
-    tokens = model.hierarchical(windows)                                       # (F, N, d)
-    conv = model.pose_encoder.conv(model.pose_encoder.norm(mel_t).transpose(1, 2)).transpose(1, 2)
-    pose_feat, _ = model.pose_encoder(mel_t)                                   # (1, K, d)
-    pose_token = pose_feat[0, mel_index]                                       # (F, d)
-    x = torch.cat([tokens, pose_token[:, None]], 1)
-    layers, attention = [], {}
-    h = x[:FIXTURE_TOKEN_FRAMES]
-    for i, block in enumerate(model.decoder.blocks):
-        h, (w_pose, w_vert) = block(h, "neighbour", model.nbr_table, model.nbr_pad, return_attention=True)
-        layers.append(h.numpy())
-        # Frame 0, mean over heads: the pose token's weights (N+1), and each vertex's over its key table (N, K).
-        attention[f"attention_pose{i}"] = w_pose[0].mean(0).numpy()
-        attention[f"attention_vertex{i}"] = w_vert[0].mean(1).masked_fill(model.nbr_pad, 0.0).numpy()
-    offsets, pose, _ = model.decode(tokens, pose_token)
-    tpl = torch.from_numpy(template_mm)
-    from .model.geometry import apply_pose
-    vertices = apply_pose(tpl[None] + offsets, pose)
-    tensors = {
-        "audio": audio.astype(np.float32), "mel": mel, "content_logits": logits[0].numpy(), "mel_index": mel_index.numpy(),
-        "windows": windows.numpy(), "tokens": tokens[:FIXTURE_TOKEN_FRAMES].numpy(), "pose_conv": conv[0].numpy(),
-        "pose_features": pose_feat[0].numpy(), "pose_token": pose_token.numpy(), "template_mm": template_mm.astype(np.float32),
-        "offsets": offsets.numpy(), "pose": pose.numpy(), "vertices": vertices.numpy(),
-    }
-    for i, l in enumerate(layers):
-        tensors[f"layer{i}"] = l
-    tensors.update(attention)
-    out.mkdir(parents=True, exist_ok=True)
-    write_safetensors(out / "fixtures.safetensors", tensors, {"frames": str(n_frames), "token_frames": str(FIXTURE_TOKEN_FRAMES)})
-    return {"file": "fixtures/fixtures.safetensors", "frames": n_frames, "token_frames": FIXTURE_TOKEN_FRAMES,
-            "seconds": FIXTURE_SECONDS, "tensors": {k: list(v.shape) for k, v in tensors.items()}}
+def check_out_template(out: Path, template: Template) -> None:
+    """The browser loads the face from OUT/template/template.json: where one is there, it must be this model's."""
+    there = out / "template" / "template.json"
+    if there.exists() and (other := json.loads(there.read_text()).get("id")) != template.id:
+        raise ValueError(f"{there} is template {other!r}, but the model was trained on {template.id!r}: "
+                         "export to another folder, or put the model's template there")
 
 
-def fixture_audio(sample_rate: int) -> np.ndarray:
-    """The fixture clip: the first FIXTURE_SECONDS of a recorded prompt shipped in the repo's test data,
-    or, without it, a deterministic synthetic vowel-like signal."""
-    n = int(FIXTURE_SECONDS * sample_rate)
-    t = np.arange(n) / sample_rate
-    f0 = 120 + 30 * np.sin(2 * np.pi * 2 * t)
-    phase = 2 * np.pi * np.cumsum(f0) / sample_rate
-    voice = sum(np.sin(k * phase) / k for k in range(1, 30)) * (0.5 + 0.5 * np.sin(2 * np.pi * 3 * t))
-    noise = np.random.default_rng(0).standard_normal(n) * 0.01
-    return (0.2 * voice / np.abs(voice).max() + noise).astype(np.float32)
-
-
-def export(checkpoint: Path, out: Path) -> dict:
-    from .train.train import load_checkpoint
-    template = load_template(TEMPLATE_DIR / "template.json")
+def export(checkpoint: Path, out: Path, template: Template | None = None) -> dict:
+    """Write the browser's files for `checkpoint` into `out`; `template` defaults to the one the checkpoint names."""
+    from .train.train import checkpoint_template, load_checkpoint
+    if template is None:
+        template = checkpoint_template(torch.load(checkpoint, map_location="cpu", weights_only=False))
+    check_out_template(out, template)
     model, ck = load_checkpoint(checkpoint, template)
     model.eval()
     cfg, a = model.cfg, model.audio
@@ -195,7 +159,8 @@ def export(checkpoint: Path, out: Path) -> dict:
           ["conv", "h0", "c0"], ["pose_features", "hn", "cn"], {"conv": {1: "K"}, "pose_features": {1: "K"}})
     files["pose_lstm"] = "pose_lstm.onnx"
     T = 4
-    tpl = torch.from_numpy(template.vertices * 10.0)[None]
+    mm_per_unit = template.to_millimetres()
+    tpl = torch.from_numpy(template.vertices * mm_per_unit)[None]
     _onnx(_Dense(model), (mel, torch.arange(10, 10 + 3 * T, 3)[None], tpl), out / "gava_dense.onnx",
           ["mel", "mel_index", "template"], ["vertices", "offsets", "pose"],
           {"mel": {1: "K"}, "mel_index": {1: "T"}, "vertices": {1: "T"}, "offsets": {1: "T"}, "pose": {1: "T"}})
@@ -204,7 +169,7 @@ def export(checkpoint: Path, out: Path) -> dict:
     write_safetensors(out / "gava.safetensors", weights)
     files["decoder_weights"] = "gava.safetensors"
 
-    template_mm = (template.vertices * template.to_millimetres()).astype(np.float32)
+    template_mm = (template.vertices * mm_per_unit).astype(np.float32)
     fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures")
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}
@@ -215,12 +180,14 @@ def export(checkpoint: Path, out: Path) -> dict:
     manifest = {
         "format": MANIFEST_FORMAT, "version": 1,
         "model": {"name": cfg.name, "config": cfg.to_dict(), "trained_steps": ck["step"],
-                  "trained_minutes": round(ck["trained_seconds"] / 60, 1), "parameters": int(sum(p.numel() for p in model.parameters()))},
+                  "trained_minutes": round(ck["trained_seconds"] / 60, 1), "parameters": int(sum(p.numel() for p in model.parameters())),
+                  "layer_norm_eps": layer_norm_eps(model)},
         "audio": a.to_dict() | {"feature_rate": a.feature_rate, "mel": "meyda melBands: symmetric Hann, power spectrum of the first frame_size/2 bins, HTK Mel 0..Nyquist, ln(1 + energy); frames centred at k * hop"},
         "timing": {"frame_time": "frame i shows t = i / fps", "mel_index": "round(i / fps * feature_rate), half to even",
                    "content_index": "floor(mel_index / content_stride)",
                    "window": f"content frames [c - {cfg.window - 1 - cfg.window_future}, c + {cfg.window_future}], zeros outside the clip"},
-        "template": {"id": template.id, "units": template.units, "vertices": template.num_vertices, "path": "template/template.json",
+        "template": {"id": template.id, "units": template.units, "mm_per_unit": mm_per_unit, "vertices": template.num_vertices,
+                     "path": "template/template.json",
                      "model_units": "mm (positions are multiplied by the template's mm per unit before the model)"},
         "tokens": {"count": "N + 1", "pose_token_index": template.num_vertices, "d_model": cfg.d_model, "heads": cfg.heads, "layers": cfg.layers,
                    "mask": "vertex j attends to itself and its 1-ring (template adjacency); the pose token attends to all; no vertex attends to the pose token"},
@@ -237,7 +204,7 @@ def export(checkpoint: Path, out: Path) -> dict:
         ]},
         "decoder_tensors": {k: list(v.shape) for k, v in weights.items()},
         # The content encoder's classes in logit order: what the engine names the phone it heard at each frame.
-        "content_phones": [*PHONES, "<blank>"][: cfg.content_classes],
+        "content_phones": list(CONTENT_CLASSES[: cfg.content_classes]),
         "fixtures": fixtures,
         "receptive_field": receptive_field(model),
         "look_ahead_ms": round(1000 * ((cfg.window_future * cfg.content_stride + receptive_field(model)["content_mel_frames"]) / a.feature_rate
@@ -254,11 +221,14 @@ def main(argv=None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--checkpoint", type=Path, default=MODELS_DIR / "checkpoint.pt")
     ap.add_argument("--out", type=Path, default=MODELS_DIR)
+    ap.add_argument("--template", type=Path, help="the template the model was trained on, when the one the checkpoint "
+                    "names is not on this machine (template.json, or a mesh with --masks)")
+    ap.add_argument("--masks", type=Path, help="region masks for a mesh template")
     args = ap.parse_args(argv)
     if not args.checkpoint.exists():
         print(f"error: checkpoint {args.checkpoint} does not exist (train one: python -m talkingface.train.train)", file=sys.stderr)
         return 2
-    m = export(args.checkpoint, args.out)
+    m = export(args.checkpoint, args.out, load_template(args.template, args.masks) if args.template else None)
     print(f"exported {m['model']['name']} ({m['model']['parameters']:,} parameters): runtime files {m['runtime_bytes'] / 1e6:.2f} MB -> {args.out}")
     return 0
 

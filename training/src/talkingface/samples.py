@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .corpus.checks import lip_gap_mm
-from .data.datasets import open_dataset, write_wav
+from .data.datasets import open_dataset
+from .geometry.contours import lip_gap
+from .wav import write_wav
 
 DEFAULT_COUNT = 3
 
@@ -60,9 +61,9 @@ def write_sample(ds, key: str, out: Path) -> dict:
             "audio": f"{key}.wav", "ground_truth": f"{key}.gt.bin", "vertices": int(clip.vertices.shape[1]),
             # The aligned phones (ARPAbet, start s, end s): the demo's timeline labels and the e2e closure test.
             "phones": [[p, round(float(a), 4), round(float(b), 4)] for p, a, b in clip.phones or []],
-            # The truth's inner-lip gap per frame (mm, corpus/checks.py): the timeline's truth curve, and the
+            # The truth's inner-lip gap per frame (mm, geometry/contours.py): the timeline's truth curve, and the
             # fixture src/template/lip-gap.ts is tested against.
-            "lip_gap_mm": np.round(lip_gap_mm(clip, ds.template, mm), 4).tolist()}
+            "lip_gap_mm": np.round(lip_gap(clip.vertices, ds.template) * mm, 4).tolist()}
 
 
 def main(argv=None) -> int:

@@ -3,7 +3,7 @@
 Reads the repository's template format (template.json + template.bin, written by
 scripts/extract-template.ts and scripts/import-template.ts) and, with a masks
 file, a user's own OBJ or PLY mesh (a FLAME head from VOCASET, a Multiface
-mesh). Nothing here assumes a vertex count.
+mesh; mesh.py reads those). Nothing here assumes a vertex count.
 """
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .mesh import MeshFormatError, read_obj, read_ply
 
 TEMPLATE_FORMAT = "talking-face-template"
 TEMPLATE_FORMAT_VERSION = 1
@@ -90,7 +92,10 @@ def load_template(path: str | Path, masks: str | Path | None = None) -> Template
         if masks is None:
             raise TemplateFormatError(f"{path.name}: a mesh template needs a masks file with its regions (docs/templates.md)")
         m = json.loads(Path(masks).read_text())
-        verts, tris, uvs = read_obj(path) if suffix == ".obj" else read_ply(path)
+        try:
+            verts, tris, uvs = read_obj(path) if suffix == ".obj" else read_ply(path)
+        except MeshFormatError as e:  # the template loader's one error type; the mesh reader's reason kept
+            raise TemplateFormatError(str(e)) from e
         return template_from_mesh(path.stem, m.get("units", "mm"), verts, tris, m.get("regions", {}), uvs, {"file": path.name})
     raise TemplateFormatError(f"{path.name}: a template must be template.json, .obj or .ply")
 
@@ -158,120 +163,6 @@ def _load_native(path: Path) -> Template:
     if missing:
         raise TemplateFormatError(f"template {t.id} lacks the regions {', '.join(missing)} (docs/templates.md)")
     return t
-
-
-def read_obj(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    verts, tex, tris = [], [], []
-    uv_of_vertex: dict[int, int] = {}
-    for line_no, line in enumerate(Path(path).read_text().splitlines(), 1):
-        parts = line.split()
-        if not parts:
-            continue
-        if parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts[0] == "vt":
-            tex.append([float(x) for x in parts[1:3]])
-        elif parts[0] == "f":
-            corners = []
-            for c in parts[1:]:
-                fields = c.split("/")
-                v = _obj_index(int(fields[0]), len(verts), path, line_no)
-                if len(fields) > 1 and fields[1]:
-                    uv_of_vertex.setdefault(v, _obj_index(int(fields[1]), len(tex), path, line_no))
-                corners.append(v)
-            tris.extend([corners[0], corners[k], corners[k + 1]] for k in range(1, len(corners) - 1))
-    if not verts or not tris:
-        raise TemplateFormatError(f"{path}: no vertices or no faces")
-    uvs = None
-    if len(uv_of_vertex) == len(verts):
-        uvs = np.array([tex[uv_of_vertex[v]] for v in range(len(verts))], dtype=np.float32)
-    return np.array(verts, dtype=np.float32), np.array(tris, dtype=np.int64), uvs
-
-
-def _obj_index(i: int, count: int, path: Path, line_no: int) -> int:
-    idx = count + i if i < 0 else i - 1
-    if not 0 <= idx < count:
-        raise TemplateFormatError(f"{path} line {line_no}: index {i} refers to no vertex")
-    return idx
-
-
-_PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
-    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
-}
-
-
-def read_ply(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    data = Path(path).read_bytes()
-    end = data.find(b"end_header")
-    if not data.startswith(b"ply") or end < 0:
-        raise TemplateFormatError(f"{path}: not a PLY file")
-    body_start = data.index(b"\n", end) + 1
-    fmt, elements = None, []
-    for line in data[:end].decode("ascii").splitlines()[1:]:
-        p = line.split()
-        if not p:
-            continue
-        if p[0] == "format":
-            fmt = p[1]
-        elif p[0] == "element":
-            elements.append((p[1], int(p[2]), []))
-        elif p[0] == "property":
-            elements[-1][2].append((p[4], p[3], p[2]) if p[1] == "list" else (p[2], p[1], None))
-    if fmt not in ("ascii", "binary_little_endian"):
-        raise TemplateFormatError(f"{path}: PLY format {fmt!r} is not supported (use ascii or binary_little_endian)")
-    rows = _ply_ascii(data[body_start:], elements) if fmt == "ascii" else _ply_binary(data, body_start, elements)
-    if "vertex" not in rows or "face" not in rows:
-        raise TemplateFormatError(f"{path}: PLY needs vertex and face elements")
-    vrows = rows["vertex"]
-    verts = np.array([[r["x"], r["y"], r["z"]] for r in vrows], dtype=np.float32)
-    uvs = None
-    if vrows and ("s" in vrows[0] or "u" in vrows[0]):
-        uvs = np.array([[r.get("s", r.get("u")), r.get("t", r.get("v"))] for r in vrows], dtype=np.float32)
-    tris = []
-    for r in rows["face"]:
-        idx = r.get("vertex_indices", r.get("vertex_index"))
-        tris.extend([idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1))
-    return verts, np.array(tris, dtype=np.int64), uvs
-
-
-def _ply_ascii(body: bytes, elements) -> dict[str, list[dict]]:
-    tokens = body.split()
-    pos, out = 0, {}
-    for name, count, props in elements:
-        rows = []
-        for _ in range(count):
-            row = {}
-            for pname, ptype, count_type in props:
-                if count_type:
-                    n = int(tokens[pos]); pos += 1
-                    row[pname] = [int(x) for x in tokens[pos : pos + n]]; pos += n
-                else:
-                    row[pname] = float(tokens[pos]); pos += 1
-            rows.append(row)
-        out[name] = rows
-    return out
-
-
-def _ply_binary(data: bytes, pos: int, elements) -> dict[str, list[dict]]:
-    out = {}
-    for name, count, props in elements:
-        rows = []
-        for _ in range(count):
-            row = {}
-            for pname, ptype, count_type in props:
-                if count_type:
-                    n = int(np.frombuffer(data, "<" + _PLY_TYPES[count_type], 1, pos)[0])
-                    pos += np.dtype(_PLY_TYPES[count_type]).itemsize
-                    row[pname] = np.frombuffer(data, "<" + _PLY_TYPES[ptype], n, pos).tolist()
-                    pos += n * np.dtype(_PLY_TYPES[ptype]).itemsize
-                else:
-                    row[pname] = float(np.frombuffer(data, "<" + _PLY_TYPES[ptype], 1, pos)[0])
-                    pos += np.dtype(_PLY_TYPES[ptype]).itemsize
-            rows.append(row)
-        out[name] = rows
-    return out
 
 
 def subdivide(t: Template, new_id: str | None = None) -> Template:

@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
 import shutil
 import subprocess
@@ -16,7 +17,9 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from .build import PRESETS, ClipBuildError, build_corpus
+from .build import build_corpus
+from .clip import ClipBuildError
+from .plan import PRESETS
 from .speech import DEBIAN_PACKAGES, SpeechToolError
 
 
@@ -65,6 +68,8 @@ def cmd_build(args) -> int:
         if shutil.which(tool) is None:
             print(f"error: {tool} is missing; run `scripts/py -m talkingface.corpus setup` first", file=sys.stderr)
             return 2
+    # Warnings (a recording spoken by a TTS voice) always show; --verbose adds each voice that failed alignment.
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     n = sum(cfg.subjects) * cfg.sentences_per_subject
     print(f"building the {cfg.preset} corpus: {sum(cfg.subjects)} subjects x {cfg.sentences_per_subject} clips = {n} clips, "
           f"seed {cfg.seed}, {args.workers} workers -> {args.out}", file=sys.stderr)
@@ -101,6 +106,7 @@ def main(argv=None) -> int:
     b.add_argument("--sentences", type=int, help="override clips per subject")
     b.add_argument("--template", type=Path, help="template.json of another face (default: the shipped MediaPipe face)")
     b.add_argument("--overwrite", action="store_true", help="replace an existing corpus in --out")
+    b.add_argument("--verbose", action="store_true", help="log every voice that failed alignment, with the reason")
     b.set_defaults(fn=cmd_build)
     c = sub.add_parser("card", help="write the dataset card (statistics and plots)")
     c.add_argument("--corpus", required=True)

@@ -9,13 +9,16 @@ festival/flite ground truth the boundaries are off by 11-16 ms on average.
 """
 from __future__ import annotations
 
+import logging
 import re
 import subprocess
 
 import numpy as np
 
-from .phonemes import PHONES, SILENCE, normalise_phone
+from ..phones import PHONES, SILENCE, normalise_phone
 from .speech import merge_silences
+
+log = logging.getLogger(__name__)
 
 ALIGN_RATE = 16000  # the en-us acoustic model's sample rate
 _FRAME = 0.01       # pocketsphinx frame shift, s
@@ -23,7 +26,7 @@ _PAD = 0.25         # silence added on both sides before aligning, s
 
 
 class AlignmentError(RuntimeError):
-    pass
+    """pocketsphinx could not align the words to the audio; the message says which words and why."""
 
 
 def spoken_words(text: str) -> list[str]:
@@ -85,14 +88,15 @@ class Aligner:
             self._decode(pcm)
             phones = [(e.name, e.start * _FRAME, (e.start + e.duration) * _FRAME) for e in d.get_alignment().phones()]
             method = "two-pass"
-        except RuntimeError:
+        except RuntimeError as first:  # pocketsphinx's "Alignment failed in frame N": the one-pass fallback below
+            log.debug("two-pass alignment of %r failed (%s); aligning its phones in one pass", text, first)
             tokens = [f"p_{p.lower()}" for w in words for p in d.lookup_word(w).split()]
             try:
                 d.set_align_text(" ".join(tokens))
                 self._decode(pcm)
                 segs = list(d.seg() or [])
             except RuntimeError as e:
-                raise AlignmentError(f"pocketsphinx could not align {text!r}: {e}") from e
+                raise AlignmentError(f"pocketsphinx could not align {text!r}: two passes: {first}; one pass: {e}") from e
             # seg() start frames come out one frame early (measured against TTS ground truth).
             phones = [("SIL" if s.word == "<sil>" else s.word[2:], s.start_frame * _FRAME + _FRAME, (s.end_frame + 1) * _FRAME + _FRAME)
                       for s in segs if s.word not in ("<s>", "</s>")]
@@ -105,7 +109,7 @@ class Aligner:
 
 def _tidy(phones, duration: float) -> list[tuple[str, float, float]]:
     """Fillers to silence, gaps filled with silence, times clipped to the audio, neighbours merged.
-    The end is left where the aligner put it (build.py records how far that is from the audio's end)."""
+    The end is left where the aligner put it (clip.py records how far that is from the audio's end)."""
     out: list[tuple[str, float, float]] = []
     t = 0.0
     for name, a, b in phones:

@@ -13,7 +13,7 @@ import subprocess
 
 import numpy as np
 
-from .speech import resample
+from ..wav import resample
 
 
 def _sox(audio: np.ndarray, sr: int, *effect: str) -> np.ndarray:

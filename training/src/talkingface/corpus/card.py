@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from ..data.datasets import open_dataset
-from .checks import OPEN_VOWELS, eye_gap_mm, gaps_at, lip_gap_mm, pose_degrees, pose_step_degrees
-from .phonemes import BILABIALS, PHONES, SILENCE
+from ..geometry.pose import pose_degrees, pose_step_degrees
+from ..phones import BILABIALS, OPEN_VOWELS, PHONES, SILENCE
+from .checks import eye_gap_mm, gaps_at, lip_gap_mm
 
 
 def write_card(corpus_dir: Path, out: Path) -> Path:
@@ -151,7 +152,8 @@ timings; espeak-ng and the recorded speech (Debian's asterisk-core-sounds-en-wav
 are force-aligned with pocketsphinx ({len(aligned)} clips: {sum(r.get('align_method') == 'two-pass' for r in aligned)} two-pass,
 {sum(r.get('align_method') == 'one-pass-phones' for r in aligned)} by the one-pass fallback;
 {sum('voices_failed_alignment' in r for r in records)} clips switched voice after a failed alignment).
-The aligner's accuracy against synthesiser ground truth is checked in `training/tests/test_corpus.py`
+{recorded_fallback(meta)}
+The aligner's accuracy against synthesiser ground truth is checked in `training/tests/corpus/test_align.py`
 (mean boundary error below 25 ms).
 
 ## Phonemes
@@ -187,3 +189,14 @@ asterisk-core-sounds-en-wav, CC-BY-SA-3.0. Synthetic speech: festival, flite and
     path = out / "README.md"
     path.write_text(text)
     return path
+
+
+def recorded_fallback(meta: dict) -> str:
+    """The card's line on clips planned as recorded speech that a TTS voice speaks (their alignment failed)."""
+    failed = meta.get("recordings_failed_alignment")
+    if failed is None:
+        return "(This corpus predates the count of recordings whose alignment failed.)"
+    if not failed:
+        return "Every recording planned for a clip was aligned."
+    return (f"{len(failed)} clip(s) planned as recorded speech are spoken by a TTS voice instead, their recording could not be "
+            "aligned: " + "; ".join(f"{k} ({v['recording']}: {v['reason']})" for k, v in sorted(failed.items())) + ".")

@@ -13,12 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .phonemes import BILABIALS, DOMINANCE, P, PHONE_INDEX, PHONES, TARGETS, VOWELS
+from ..phones import BILABIALS, PHONE_INDEX, PHONES, VOWELS
+from .visemes import DOMINANCE, P, TARGETS
 
 
 @dataclass(frozen=True)
 class Segment:
-    phone: str   # ARPAbet (phonemes.PHONES)
+    phone: str   # ARPAbet (talkingface.phones)
     start: float  # seconds
     end: float
 

@@ -7,9 +7,10 @@ line). Phone timings come from forced alignment (align.py).
 from __future__ import annotations
 
 import gzip
-import wave
 from dataclasses import dataclass
 from pathlib import Path
+
+from ..wav import wav_seconds
 
 SOUNDS_DIR = Path("/usr/share/asterisk/sounds/en_US_f_Allison")
 TRANSCRIPTS = Path("/usr/share/doc/asterisk-core-sounds-en/core-sounds-en.txt.gz")
@@ -46,8 +47,7 @@ def recordings(min_words: int = 3, min_seconds: float = 1.0, max_seconds: float 
             path = SOUNDS_DIR / f"{name}.wav"
             if not path.exists():
                 continue
-            with wave.open(str(path)) as w:
-                duration = w.getnframes() / w.getframerate()
+            duration = wav_seconds(path)
             if min_seconds <= duration <= max_seconds:
                 out.append(Recording(name, text, path, duration))
     return sorted(out, key=lambda r: r.name)

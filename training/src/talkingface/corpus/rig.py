@@ -1,7 +1,7 @@
 """A procedural articulation rig on any template with the standard regions.
 
 It plays the part of the paper's 4D capture: given per-frame articulation
-parameters (phonemes.PARAMS, plus blink and brow), it produces the displaced
+parameters (visemes.PARAMS, plus blink and brow), it produces the displaced
 face I + O for every frame, with exact geometry (lips that touch on /p b m/,
 lids that meet on a blink). All magnitudes are relative to the mouth width, so
 a template in cm, mm or metres, with 468 or 5023 vertices, moves alike.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..template import Template
-from .phonemes import P
+from .visemes import P
 
 
 @dataclass(frozen=True)

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data.datasets import read_wav
-from .phonemes import SILENCE, normalise_phone
+from ..wav import read_wav, resample
+from ..phones import SILENCE, normalise_phone
 
 FESTIVAL_VOICES = {"kal": "voice_kal_diphone", "ked": "voice_ked_diphone", "slt": "voice_cmu_us_slt_arctic_hts"}
 FLITE_VOICES = ("slt", "rms", "awb")  # kal/kal16 cut the final pause (platform.md)
@@ -74,7 +74,7 @@ def tool_versions() -> dict[str, str]:
     for p in ("pocketsphinx", "numpy"):
         try:
             out[p] = version(p)
-        except PackageNotFoundError:
+        except PackageNotFoundError:  # the reason is the answer: meta.json records it
             out[p] = "not installed"
     return out
 
@@ -94,16 +94,6 @@ def _run(cmd: list[str], **kw) -> subprocess.CompletedProcess:
         raise SpeechToolError(f"{' '.join(cmd[:3])} failed: {e.stderr.strip()[:300]}") from e
     except subprocess.TimeoutExpired as e:
         raise SpeechToolError(f"{' '.join(cmd[:3])} timed out after 120 s") from e
-
-
-def resample(audio: np.ndarray, sr_in: int, sr_out: int) -> np.ndarray:
-    """Band-limited resampling by sox (its default very-high-quality rate converter)."""
-    if sr_in == sr_out:
-        return audio.astype(np.float32)
-    res = subprocess.run(
-        ["sox", "-t", "f32", "-r", str(sr_in), "-c", "1", "-", "-t", "f32", "-r", str(sr_out), "-c", "1", "-", "rate", "-v"],
-        input=audio.astype("<f4").tobytes(), capture_output=True, check=True)
-    return np.frombuffer(res.stdout, "<f4").astype(np.float32)
 
 
 def synthesize(voice: Voice, text: str, sample_rate: int) -> tuple[np.ndarray, list[tuple[str, float, float]] | None]:

@@ -20,13 +20,13 @@ from __future__ import annotations
 
 import json
 import pickle
-import wave
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..template import MM_PER_UNIT, Template, load_template
+from ..wav import WavError, read_wav
 
 CORPUS_FORMAT = "talking-face-corpus"
 
@@ -87,7 +87,10 @@ class FaceDataset:
 
     def load(self, key: str) -> Clip:
         subject = self.subject_of(key)
-        audio, sr = read_wav(self.root / "wav" / f"{key}.wav")
+        try:
+            audio, sr = read_wav(self.root / "wav" / f"{key}.wav")
+        except WavError as e:  # the dataset's error, naming the clip; the WAV reader's reason kept
+            raise DatasetError(f"clip {key}: {e}") from e
         verts = np.load(self.root / "vertices_npy" / f"{key}.npy")[:: self._frame_step]
         n = self.template.num_vertices
         if verts.ndim != 2 or verts.shape[1] != n * 3:
@@ -159,47 +162,3 @@ def _read_templates_pkl(root: Path) -> dict[str, np.ndarray]:
         # VOCASET's templates.pkl is a Python 2 pickle of numpy arrays (FaceFormer: encoding='latin1').
         data = pickle.load(f, encoding="latin1")
     return {k: np.asarray(v, dtype=np.float32) for k, v in data.items()}
-
-
-def read_wav(path: Path) -> tuple[np.ndarray, int]:
-    """16-bit PCM or 32-bit float WAV -> (mono float32 in [-1, 1], sample rate)."""
-    if not path.exists():
-        raise DatasetError(f"missing audio {path}")
-    with open(path, "rb") as f:
-        raw = f.read()
-    if raw[:4] != b"RIFF" or raw[8:12] != b"WAVE":
-        raise DatasetError(f"{path} is not a WAV file")
-    pos, fmt, data = 12, None, None
-    while pos + 8 <= len(raw):
-        cid, size = raw[pos : pos + 4], int.from_bytes(raw[pos + 4 : pos + 8], "little")
-        body = raw[pos + 8 : pos + 8 + size]
-        if cid == b"fmt ":
-            fmt = (int.from_bytes(body[0:2], "little"), int.from_bytes(body[2:4], "little"),
-                   int.from_bytes(body[4:8], "little"), int.from_bytes(body[14:16], "little"))
-        elif cid == b"data":
-            data = body
-        pos += 8 + size + (size & 1)
-    if fmt is None or data is None:
-        raise DatasetError(f"{path}: WAV without fmt or data chunk")
-    code, channels, sr, bits = fmt
-    if code == 1 and bits == 16:
-        x = np.frombuffer(data[: len(data) // 2 * 2], "<i2").astype(np.float32) / 32768.0
-    elif code == 3 and bits == 32:
-        x = np.frombuffer(data[: len(data) // 4 * 4], "<f4").astype(np.float32)
-    elif code == 0xFFFE and bits == 16:
-        x = np.frombuffer(data[: len(data) // 2 * 2], "<i2").astype(np.float32) / 32768.0
-    else:
-        raise DatasetError(f"{path}: WAV encoding {code} with {bits} bits is not supported (use 16-bit PCM or float32)")
-    if channels > 1:
-        x = x[: len(x) // channels * channels].reshape(-1, channels).mean(1)
-    return x, sr
-
-
-def write_wav(path: Path, audio: np.ndarray, sr: int) -> None:
-    """Mono float audio -> 16-bit PCM WAV (clipped to [-1, 1])."""
-    pcm = (np.clip(audio, -1.0, 1.0) * 32767.0).round().astype("<i2")
-    with wave.open(str(path), "wb") as w:
-        w.setnchannels(1)
-        w.setsampwidth(2)
-        w.setframerate(sr)
-        w.writeframes(pcm.tobytes())

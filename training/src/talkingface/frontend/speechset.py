@@ -33,12 +33,12 @@ import numpy as np
 from ..corpus import kokoro, recorded
 from ..corpus.align import AlignmentError, Aligner
 from ..corpus.augment import augment_channel, augment_speech
-from ..corpus.build import PRESETS, _split_of_recording, is_test_voice
-from ..corpus.phonemes import PHONE_INDEX, SILENCE
+from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
 from ..corpus.sentences import generate_sentences
-from ..corpus.speech import Voice, all_voices, fit_to_duration, resample, synthesize
-from ..data.datasets import read_wav
+from ..corpus.speech import Voice, all_voices, fit_to_duration, synthesize
 from ..features import AudioConfig, log_mel
+from ..phones import PHONE_INDEX, SILENCE
+from ..wav import read_wav, resample
 
 AUGMENT_SHARE = 0.7
 SHARES = {"kokoro": 0.6, "classic": 0.25, "human": 0.15}  # of the clips; the human share is capped by the recordings
@@ -66,7 +66,7 @@ def texts(n: int, seed: int) -> list[str]:
     banned = face_test_sentences()
     out = [s for s in generate_sentences(n + len(banned), seed + 1000) if s not in banned][:n]
     if recorded.available():
-        out += [r.text for r in recorded.recordings() if _split_of_recording(r.name) == "train"]
+        out += [r.text for r in recorded.recordings() if split_of_recording(r.name) == "train"]
     return out
 
 
@@ -78,7 +78,7 @@ def plan(minutes: float, seed: int) -> list[SpeechSpec]:
     if not k_voices:
         raise kokoro.KokoroMissing("Kokoro is not set up: run `scripts/py -m talkingface.corpus setup --kokoro`")
     classic = [v for v in all_voices() if not is_test_voice(v)]
-    humans = [r for r in recorded.recordings() if _split_of_recording(r.name) == "train"] if recorded.available() else []
+    humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
     for i in range(n):
         key = f"s{i:05d}"

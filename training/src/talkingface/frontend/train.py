@@ -21,11 +21,11 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from ..corpus.phonemes import BILABIALS, PHONE_INDEX
 from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
+from ..phones import BILABIALS, PHONE_INDEX
 from ..train import articulation as art
 from ..train.data import prepare
 

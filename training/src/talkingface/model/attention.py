@@ -15,7 +15,6 @@ import math
 
 import torch
 import torch.nn as nn
-import torch.nn.functional as F
 
 
 def neighbour_table(adj_offsets, adj_indices, num_vertices: int) -> tuple[torch.Tensor, torch.Tensor]:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
 
-from ..corpus.phonemes import PHONES
+from ..phones import CONTENT_CLASSES
 
 
 # Values that fields added later had implicitly before they existed (what an older checkpoint means).
@@ -19,7 +19,7 @@ class ModelConfig:
     heads: int = 4                # attention heads (d_k = d_model / heads)
     layers: int = 3               # attention layers (the paper's Fig. 7 reads the third)
     ffn: int = 64                 # feed-forward hidden size
-    content_classes: int = len(PHONES) + 1  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
+    content_classes: int = len(CONTENT_CLASSES)  # D: ARPAbet phones + silence + CTC-style blank (as DeepSpeech's alphabet + blank)
     content_arch: str = "dilated" # "dilated": residual dilated convolutions reading 550 ms back, 70 ms ahead (issue 14);
                                   # "conv4": the first encoder, four convolutions reading 70 ms each way
     content_channels: int = 128   # content encoder width

@@ -15,12 +15,12 @@ import torch
 import torch.nn as nn
 
 from ..features import AudioConfig, frame_to_mel_index
+from ..geometry.pose_torch import apply_pose
 from ..template import Template
 from .attention import gava_dense_mask, neighbour_table
 from .config import ModelConfig
 from .decoders import AttentionDecoder, MLPDecoder
 from .encoders import ContentEncoder, HierarchicalFeature, PoseEncoder
-from .geometry import apply_pose
 
 
 class TalkingFace(nn.Module):

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..corpus.checks import OPEN_VOWELS, contour_gap
-from ..corpus.phonemes import BILABIALS, PHONES, SILENCE
+from ..geometry.contours import lip_gap
+from ..phones import BILABIALS, OPEN_VOWELS, PHONES, SILENCE
 from ..template import Template
 
 CLOSED_MM = 1.0   # inner lips this close count as closed
@@ -28,8 +28,7 @@ MIN_OPEN_VOWEL_S = 0.08  # shorter open vowels are not expected to open fully, e
 
 def inner_lip_gap(unposed_mm: np.ndarray, template: Template) -> np.ndarray:
     """(F, N, 3) unposed vertices in mm -> (F,) inner-lip gap in mm."""
-    r = template.regions
-    return contour_gap(unposed_mm, r["lips_inner_upper"], r["lips_inner_lower"])
+    return lip_gap(unposed_mm, template)
 
 
 def segment_frames(start: float, end: float, fps: float, n_frames: int) -> np.ndarray:

@@ -23,12 +23,13 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from ..corpus.phonemes import PHONE_INDEX, SILENCE
-from ..corpus.checks import contour_gap
 from ..data.datasets import FaceDataset
 from ..features import AudioConfig, frame_to_mel_index, log_mel
+from ..geometry.contours import contour_gap
 from ..model.config import ModelConfig
+from ..phones import PHONE_INDEX, SILENCE
 from ..template import Template
+from ..wav import resample
 
 WARMUP_SECONDS = 1.0
 
@@ -52,12 +53,7 @@ class PreparedClip:
 
 def prepare(ds: FaceDataset, key: str, audio: AudioConfig = AudioConfig()) -> PreparedClip:
     clip = ds.load(key)
-    if clip.sample_rate != audio.sample_rate:
-        from ..corpus.speech import resample
-        wav = resample(clip.audio, clip.sample_rate, audio.sample_rate)
-    else:
-        wav = clip.audio
-    mel = log_mel(wav, audio)
+    mel = log_mel(resample(clip.audio, clip.sample_rate, audio.sample_rate), audio)
     k = mel.shape[0]
     phones = np.full(k, PHONE_INDEX[SILENCE], dtype=np.int64)
     for p, a, b in clip.phones or []:

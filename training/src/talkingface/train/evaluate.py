@@ -16,11 +16,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..corpus.pose import apply_pose as apply_pose_np
 from ..data.datasets import open_dataset
+from ..features import frame_to_mel_index, log_mel
+from ..geometry.contours import lip_gap
+from ..geometry.pose import apply_pose as apply_pose_np
 from . import articulation as art
 from . import head_motion as hm
-from ..features import frame_to_mel_index
 from .data import prepare
 from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
@@ -84,14 +85,11 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
 def silence_probe(model, template) -> dict:
     """Two seconds of digital silence: how far apart does the model leave the inner lips (mm)?
     The corpus rig closes them in silence (about 0.4 mm, docs/corpus)."""
-    from ..corpus.checks import contour_gap
-    from ..features import log_mel
     mm = template.to_millimetres()
     tpl = torch.from_numpy(template.vertices * mm)
     out = model.animate(torch.from_numpy(log_mel(np.zeros(2 * model.audio.sample_rate, np.float32), model.audio)), tpl, 2 * model.audio.fps)
-    r = template.regions
-    gap = contour_gap(out["unposed"].numpy(), r["lips_inner_upper"], r["lips_inner_lower"])
-    neutral = contour_gap(tpl[None].numpy(), r["lips_inner_upper"], r["lips_inner_lower"])[0]
+    gap = lip_gap(out["unposed"].numpy(), template)
+    neutral = lip_gap(tpl[None].numpy(), template)[0]
     return {"lip_gap_mean_mm": float(gap.mean()), "lip_gap_max_mm": float(gap.max()), "neutral_template_gap_mm": float(neutral)}
 
 

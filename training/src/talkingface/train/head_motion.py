@@ -17,12 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..geometry.pose import pose_step_degrees
+
 AXES = ("pitch", "yaw", "roll")  # rotation about x, y, z (axis-angle components, template axes)
-
-
-def angular_speed_deg(pose: np.ndarray) -> np.ndarray:
-    """(F, 6) -> (F-1,) rotation between consecutive frames, degrees (small angles: the axis-angle difference)."""
-    return np.degrees(np.linalg.norm(np.diff(pose[:, :3], axis=0), axis=1))
 
 
 def envelope(mel: np.ndarray, mel_index: np.ndarray) -> np.ndarray:
@@ -39,7 +36,7 @@ def _corr(a: np.ndarray, b: np.ndarray) -> float:
 def clip_head_motion(true_pose: np.ndarray, pred_pose: np.ndarray, env: np.ndarray) -> dict:
     n = min(len(true_pose), len(pred_pose))
     t, p = true_pose[:n], pred_pose[:n]
-    speed_t, speed_p = angular_speed_deg(t), angular_speed_deg(p)
+    speed_t, speed_p = pose_step_degrees(t), pose_step_degrees(p)
     # Envelope change between the same consecutive frames: the head moves on stressed, loud syllables.
     loud = np.abs(np.diff(env[:n])) + 0.5 * (env[1:n] - env[:n].mean())
     return {"std_true": np.degrees(t[:, :3].std(0)).tolist(), "std_pred": np.degrees(p[:, :3].std(0)).tolist(),

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import torch
 import torch.nn.functional as F
 
-from ..model.geometry import apply_pose
+from ..geometry.pose_torch import apply_pose
 
 
 @dataclass(frozen=True)

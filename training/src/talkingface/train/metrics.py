@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..corpus.pose import rotvec_to_matrix
+from ..geometry.pose import rotvec_to_matrix
 from ..template import Template
 
 

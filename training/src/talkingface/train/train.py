@@ -15,7 +15,6 @@ import json
 import os
 import sys
 import time
-from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,19 +25,35 @@ from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
+from ..paths import REPO_ROOT, TEMPLATE_DIR
+from ..template import Template, TemplateFormatError, load_template
 from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
 from .losses import LossWeights, total_loss
 from .metrics import eye_region, inner_lip_pairs, lip_region
 
 
-def load_checkpoint(path: Path, template=None):
-    """-> (model, checkpoint dict). `template` defaults to the dataset template recorded in the checkpoint."""
+def checkpoint_template(ck: dict) -> Template:
+    """The template a checkpoint was trained on: the path training recorded (as given, or from the repository
+    root), or, where that is not on this machine, the shipped template when it has the recorded id."""
+    recorded = Path(ck["template_path"])
+    masks = ck.get("args", {}).get("masks")
+    for path in (recorded, REPO_ROOT / recorded):
+        if path.exists():
+            return load_template(path, masks)
+    shipped = load_template(TEMPLATE_DIR / "template.json")
+    if shipped.id != ck["template_id"]:
+        raise TemplateFormatError(f"the checkpoint was trained on template {ck['template_id']!r} ({recorded}), which is not "
+                                  f"on this machine and is not the shipped {shipped.id!r}: name it (--template)")
+    return shipped
+
+
+def load_checkpoint(path: Path, template: Template | None = None):
+    """-> (model, checkpoint dict). `template` defaults to the one the checkpoint names (checkpoint_template)."""
     ck = torch.load(path, map_location="cpu", weights_only=False)
     cfg = ModelConfig.from_dict(ck["model_config"])
     audio = AudioConfig(**ck["audio_config"])
     if template is None:
-        from ..template import load_template
-        template = load_template(ck["template_path"])
+        template = checkpoint_template(ck)
     if template.id != ck["template_id"]:
         raise ValueError(f"{path} was trained on template {ck['template_id']}, not {template.id}")
     model = TalkingFace(cfg, template, audio)

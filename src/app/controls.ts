@@ -1,0 +1,112 @@
+/** The demo page's elements and their events: what each control asks for, handed to main.ts as plain calls. */
+
+const $ = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
+
+export const ui = {
+  status: $<HTMLParagraphElement>('status'),
+  canvas: $<HTMLCanvasElement>('face-canvas'),
+  fileInput: $<HTMLInputElement>('file-input'),
+  recordButton: $<HTMLButtonElement>('record-button'),
+  cancelButton: $<HTMLButtonElement>('cancel-button'),
+  backendSelect: $<HTMLSelectElement>('backend-select'),
+  playButton: $<HTMLButtonElement>('play-button'),
+  loopCheck: $<HTMLInputElement>('loop-check'),
+  scrub: $<HTMLInputElement>('scrub'),
+  timeLabel: $<HTMLOutputElement>('time-label'),
+  clipInfo: $<HTMLSpanElement>('clip-info'),
+  sampleSelect: $<HTMLSelectElement>('sample-select'),
+  arrowsCheck: $<HTMLInputElement>('arrows-check'),
+  paintSelect: $<HTMLSelectElement>('paint-select'),
+  sideCheck: $<HTMLInputElement>('side-check'),
+  gtView: $<HTMLElement>('gt-view'),
+  gtCanvas: $<HTMLCanvasElement>('gt-canvas'),
+  legend: $<HTMLParagraphElement>('legend'),
+  exportGlbButton: $<HTMLButtonElement>('export-glb'),
+  exportRawButton: $<HTMLButtonElement>('export-raw'),
+  stage: $<HTMLElement>('stage'),
+  dropHint: $<HTMLParagraphElement>('drop-hint'),
+  timeline: $<HTMLCanvasElement>('timeline'),
+};
+
+export function showStatus(text: string, isError = false): void {
+  ui.status.textContent = text;
+  ui.status.classList.toggle('error', isError);
+}
+
+/** Show a legend line (HTML: it may hold the colour ramp), or hide it with null. */
+export function showLegend(html: string | null): void {
+  ui.legend.hidden = html === null;
+  if (html !== null) ui.legend.innerHTML = html;
+}
+
+export interface ControlActions {
+  openFile(file: File): void;
+  openSample(name: string): void;
+  toggleRecording(): void;
+  cancel(): void;
+  togglePlay(): void;
+  seek(frame: number): void;
+  step(delta: number): void;
+  hasTake(): boolean;
+  setLoop(on: boolean): void;
+  setArrows(on: boolean): void;
+  repaint(): void;
+  setSideBySide(on: boolean): void;
+  /** A click on the face at client coordinates (x, y), when painting one vertex's attention. */
+  pick(x: number, y: number): void;
+  setBackend(choice: string): void;
+  exportGlb(): void;
+  exportRaw(): void;
+}
+
+export function bindControls(a: ControlActions): void {
+  ui.sampleSelect.addEventListener('change', () => {
+    if (ui.sampleSelect.value) a.openSample(ui.sampleSelect.value);
+  });
+  ui.arrowsCheck.addEventListener('change', () => a.setArrows(ui.arrowsCheck.checked));
+  ui.paintSelect.addEventListener('change', () => a.repaint());
+  ui.sideCheck.addEventListener('change', () => a.setSideBySide(ui.sideCheck.checked));
+  ui.loopCheck.addEventListener('change', () => a.setLoop(ui.loopCheck.checked));
+  ui.canvas.addEventListener('click', (ev) => {
+    if (ui.paintSelect.value === 'vertex-attention') a.pick(ev.clientX, ev.clientY);
+  });
+  ui.exportGlbButton.addEventListener('click', () => a.exportGlb());
+  ui.exportRawButton.addEventListener('click', () => a.exportRaw());
+  ui.fileInput.addEventListener('change', () => {
+    const file = ui.fileInput.files?.[0];
+    if (file) a.openFile(file);
+    ui.fileInput.value = '';
+  });
+  ui.recordButton.addEventListener('click', () => a.toggleRecording());
+  ui.cancelButton.addEventListener('click', () => a.cancel());
+  ui.playButton.addEventListener('click', () => a.togglePlay());
+  ui.scrub.addEventListener('input', () => a.seek(Number(ui.scrub.value)));
+  ui.backendSelect.addEventListener('change', () => a.setBackend(ui.backendSelect.value));
+  document.addEventListener('keydown', (ev) => {
+    // Space plays/pauses and arrows step frames when the viewer has focus.
+    if (document.activeElement !== ui.canvas || !a.hasTake()) return;
+    if (ev.key === ' ') {
+      ev.preventDefault();
+      a.togglePlay();
+    } else if (ev.key === 'ArrowRight' || ev.key === 'ArrowLeft') {
+      ev.preventDefault();
+      a.step(ev.key === 'ArrowRight' ? 1 : -1);
+    }
+  });
+  ui.stage.addEventListener('dragover', (e) => {
+    e.preventDefault();
+    ui.stage.classList.add('dragging');
+    ui.dropHint.hidden = false;
+  });
+  ui.stage.addEventListener('dragleave', () => {
+    ui.stage.classList.remove('dragging');
+    ui.dropHint.hidden = true;
+  });
+  ui.stage.addEventListener('drop', (e) => {
+    e.preventDefault();
+    ui.stage.classList.remove('dragging');
+    ui.dropHint.hidden = true;
+    const file = e.dataTransfer?.files?.[0];
+    if (file) a.openFile(file);
+  });
+}

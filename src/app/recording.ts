@@ -1,0 +1,70 @@
+/**
+ * The demo's microphone take: the face follows the voice live while recording; on stop, the streamed frames
+ * become the take (or the whole take is animated again if frames were skipped to keep up).
+ */
+import type { TalkingFaceEngine, Animation, Frames } from '../engine/engine';
+import type { LiveSession } from '../engine/live';
+import { joinFrames } from '../engine/frames';
+import { openMicrophone } from '../audio/capture';
+
+export interface FinishedTake {
+  animation: Animation;
+  buffer: AudioBuffer;
+  samples: Float32Array;
+  seconds: number;
+  computeMs: number;
+}
+
+export class Recording {
+  private readonly frames: Frames[] = [];
+
+  private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
+
+  /** Open the microphone and animate it live; `onFrames` shows each chunk, `onError` reports a failure. */
+  static async start(engine: TalkingFaceEngine, onFrames: (frames: Frames) => void, onError: (error: Error) => void): Promise<Recording> {
+    const media = await openMicrophone();
+    engine.resetTimes();
+    let recording: Recording | null = null;
+    const pending: Frames[] = [];
+    const live = await engine.listen(media, (_, f) => {
+      (recording?.frames ?? pending).push(f);
+      onFrames(f);
+    }, { onError });
+    recording = new Recording(engine, live);
+    recording.frames.push(...pending);
+    return recording;
+  }
+
+  /** One line on the live state: seconds, decoder, latency, frames skipped. */
+  describe(): string {
+    const lat = this.live.stream.latency;
+    return `Recording ${this.live.seconds.toFixed(1)} s: the face follows your voice. Decoder ${this.engine.backend}, ` +
+      `latency ${Number.isFinite(lat.p50Ms) ? Math.round(lat.p50Ms) : '…'} ms (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms)` +
+      (this.live.stream.skippedFrames ? `, ${this.live.stream.skippedFrames} frames skipped to keep up` : '') + '.';
+  }
+
+  /**
+   * Stop and return the take, or null when it is too short to animate (under 0.1 s). `onReanimate` is told
+   * when the whole take must be animated again because frames were skipped live.
+   */
+  async finish(onReanimate: () => void): Promise<FinishedTake | null> {
+    const e = this.engine;
+    const samples = await this.live.stop();
+    const rate = e.manifest.audio.sample_rate;
+    if (samples.length < rate / 10) return null;
+    const buffer = new AudioBuffer({ length: samples.length, sampleRate: rate, numberOfChannels: 1 });
+    buffer.copyToChannel(new Float32Array(samples), 0);
+    const t = e.times;
+    const computeMs = t.mel + t.content + t.hierarchical + t.pose + t.decoder + t.posing;
+    const streamed = this.frames.reduce((s, f) => s + f.count, 0);
+    let animation: Animation;
+    if (this.live.stream.skippedFrames === 0 && streamed === e.frameCount(samples.length)) {
+      animation = joinFrames(this.frames, e.fps);
+    } else {
+      // The device fell behind while live (frames were skipped to stay live): animate the take again, whole.
+      onReanimate();
+      animation = await e.animate(samples, { unposed: true });
+    }
+    return { animation, buffer, samples, seconds: samples.length / rate, computeMs };
+  }
+}

@@ -1,0 +1,111 @@
+/**
+ * What the demo shows about the current take besides the face: the ground truth beside it, the lip timeline,
+ * the scrubber and time, the painted maps, and E_vl against a sample's truth.
+ */
+import { FaceView } from '../render/face-view';
+import { lipMask as lipMaskOf } from '../template/face-template';
+import { innerLipGaps } from '../template/lip-gap';
+import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
+import { LipTimeline } from './timeline';
+import { Painter, type PaintMode } from './paint';
+import { clipLipError, onTruthFace, type Truth } from './samples';
+import { showLegend, ui } from './controls';
+
+export interface Take {
+  animation: Animation;
+  buffer: AudioBuffer;
+  /** The audio at the model's rate (for attention maps). */
+  samples: Float32Array;
+  name: string;
+  seconds: number;
+  computeMs: number;
+  backend: Backend;
+  truth?: Truth;
+  /** E_vl of the whole take against its ground truth (mm), computed once. */
+  lipError?: number;
+}
+
+export class TakeView {
+  truthView: FaceView | null = null;
+  private readonly timeline = new LipTimeline(ui.timeline);
+  private readonly painter: Painter;
+  private readonly lipMask: Uint8Array;
+  private picked: number | null = null;
+
+  constructor(private readonly view: FaceView) {
+    this.painter = new Painter(view, showLegend, (mode) => (document.body.dataset.painted = mode));
+    this.lipMask = lipMaskOf(view.template);
+    addEventListener('resize', () => this.timeline.redraw());
+  }
+
+  /** Frame f of a take as drawn: on the sample subject's own face when there is ground truth. */
+  drawn(take: Take): (f: number, unposed: Float32Array) => Float32Array {
+    return take.truth ? onTruthFace(take.truth, this.view.template.positions) : (_f, u) => u;
+  }
+
+  /** E_vl of a sample take (mm), computed once; NaN without ground truth. */
+  lipError(take: Take, engine: TalkingFaceEngine): number {
+    if (!take.truth) return NaN;
+    const shape = this.drawn(take);
+    const n3 = this.view.template.vertexCount * 3;
+    const frame = (f: number) => shape(f, take.animation.unposed!.subarray(f * n3, (f + 1) * n3));
+    return (take.lipError ??= clipLipError(frame, take.animation.frames, take.truth, this.lipMask, 1 / engine.unitsPerMm));
+  }
+
+  /** The lip timeline of a take: predicted gap and heard phones, and the truth's for a sample clip. */
+  showTimeline(take: Take, engine: TalkingFaceEngine): void {
+    const a = take.animation;
+    if (!a.unposed) return this.timeline.clear();
+    const { lips_inner_upper: upper, lips_inner_lower: lower } = this.view.template.regions;
+    const gap = innerLipGaps(a.unposed, a.frames, this.view.template.vertexCount, upper, lower).map((g) => g / engine.unitsPerMm);
+    this.timeline.show({ fps: a.fps, gap, heard: Array.from(a.phones, (k) => engine.manifest.content_phones[k]), truthGap: take.truth?.lipGapMm, truthPhones: take.truth?.phones });
+  }
+
+  /** After the player shows frame f: the truth beside it, the timeline, scrubber and time, the paint. */
+  frameShown(take: Take, engine: TalkingFaceEngine, f: number, playing: boolean): void {
+    const n = this.view.template.vertexCount;
+    const truth = take.truth;
+    if (truth && this.truthView) {
+      const g = Math.min(f, truth.frames - 1);
+      this.truthView.setVertices(truth.unposed.subarray(g * n * 3, (g + 1) * n * 3));
+      const q = truth.pose;
+      this.truthView.setPose(q[g * 6], q[g * 6 + 1], q[g * 6 + 2], q[g * 6 + 3], q[g * 6 + 4], q[g * 6 + 5]);
+    }
+    this.timeline.setPlayhead(f);
+    ui.scrub.value = String(f);
+    ui.timeLabel.value = `${(f / take.animation.fps).toFixed(2)} s`;
+    this.paint(take, engine, f, playing);
+  }
+
+  paint(take: Take | null, engine: TalkingFaceEngine | null, f: number, playing: boolean): void {
+    if (!take || !engine) return this.painter.paint(null);
+    const n3 = this.view.template.vertexCount * 3;
+    const u = take.animation.unposed!.subarray(f * n3, (f + 1) * n3);
+    this.painter.paint({
+      mode: ui.paintSelect.value as PaintMode, engine, samples: take.samples, frame: f, truth: take.truth, lipMask: this.lipMask, playing,
+      predicted: this.drawn(take)(f, u), clipError: () => this.lipError(take, engine), vertex: this.picked,
+    });
+  }
+
+  /** Choose the vertex whose attention is painted (a click on the face); true when one was hit. */
+  pick(x: number, y: number): boolean {
+    const v = this.view.pickVertex(x, y);
+    if (v !== null) this.picked = v;
+    return v !== null;
+  }
+
+  setArrows(on: boolean): void {
+    this.view.showPoseArrows(on);
+    this.truthView?.showPoseArrows(on);
+  }
+
+  /** Show or hide the ground truth beside the prediction; says so when the take has none. */
+  setSideBySide(on: boolean, take: Take | null): void {
+    ui.gtView.hidden = !on;
+    if (on && !this.truthView) {
+      this.truthView = new FaceView(ui.gtCanvas, this.view.template);
+      this.truthView.showPoseArrows(ui.arrowsCheck.checked);
+    }
+    if (on && !take?.truth) showLegend('Side by side needs a sample clip (it has ground truth).');
+  }
+}

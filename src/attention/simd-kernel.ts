@@ -1,0 +1,141 @@
+/**
+ * The CPU decoder's WebAssembly SIMD kernel (simd/decoder.wat, assembled by `npm run build:wasm` into
+ * simd/decoder-wasm.ts): the DecoderKernel operations over one WebAssembly memory. Where SIMD is missing the
+ * TypeScript kernel (decoder-kernels.ts) runs instead, and simdUnavailable says why.
+ */
+import { WASM_BASE64 } from './simd/decoder-wasm';
+import { GELU_RANGE, GELU_STEPS, geluTableData, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
+
+let module: WebAssembly.Module | null | undefined;
+
+/** Why the SIMD kernel is not used here ('' while it is, or before simdModule() was asked). */
+export let simdUnavailable = '';
+
+/** The compiled SIMD module, or null where this runtime has no WebAssembly SIMD. */
+export function simdModule(): WebAssembly.Module | null {
+  if (module !== undefined) return module;
+  module = null;
+  if (typeof WebAssembly !== 'object') {
+    simdUnavailable = 'this runtime has no WebAssembly';
+    return module;
+  }
+  const bin = atob(WASM_BASE64);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+  try {
+    if (WebAssembly.validate(bytes)) module = new WebAssembly.Module(bytes);
+    else simdUnavailable = 'this runtime has no WebAssembly SIMD';
+  } catch (e) {
+    // e.g. a Content-Security-Policy without 'wasm-unsafe-eval': the TypeScript kernel runs, and the reason is kept.
+    module = null;
+    simdUnavailable = (e as Error).message;
+  }
+  return module;
+}
+
+interface SimdExports {
+  memory: WebAssembly.Memory;
+  matmul(wt: number, b: number, outs: number, cols: number, x: number, rows: number, out: number): void;
+  layer_norm(x: number, rows: number, d: number, g: number, b: number, out: number, eps: number): void;
+  attention(qkv: number, tokens: number, d: number, heads: number, keyStart: number, keyIndex: number, scores: number, out: number, scale: number): void;
+  gelu(a: number, count: number, value: number, slope: number, range: number, steps: number): void;
+  add(x: number, y: number, count: number): void;
+}
+
+/** The SIMD kernel over one memory of `bytes` bytes (everything alloc'd, placed and packed, plus alignment). */
+export class SimdKernel implements DecoderKernel {
+  readonly name = 'wasm-simd';
+  private readonly exports: SimdExports;
+  private used = 0;
+  private readonly capacity: number;
+  private readonly geluValue: Float64Array;
+  private readonly geluSlope: Float64Array;
+
+  constructor(bytes: number) {
+    const mod = simdModule();
+    if (!mod) throw new Error('WebAssembly SIMD is not available in this runtime');
+    this.exports = new WebAssembly.Instance(mod).exports as unknown as SimdExports;
+    const table = geluTableData();
+    const need = bytes + 16 * table.value.length + 4096;
+    const have = this.exports.memory.buffer.byteLength;
+    if (need > have) this.exports.memory.grow(Math.ceil((need - have) / 65536));
+    this.capacity = this.exports.memory.buffer.byteLength;
+    this.geluValue = this.take(Float64Array, table.value.length);
+    this.geluValue.set(table.value);
+    this.geluSlope = this.take(Float64Array, table.slope.length);
+    this.geluSlope.set(table.slope);
+  }
+
+  private take<A extends Float32Array | Int32Array | Float64Array>(kind: { new (b: ArrayBuffer, o: number, n: number): A; BYTES_PER_ELEMENT: number }, length: number): A {
+    const start = (this.used + 15) & ~15; // 16-byte aligned: one vector
+    if (start + length * kind.BYTES_PER_ELEMENT > this.capacity) throw new Error(`SimdKernel: ${length} values more than reserved`);
+    this.used = start + length * kind.BYTES_PER_ELEMENT;
+    return new kind(this.exports.memory.buffer, start, length);
+  }
+
+  alloc(length: number): Float32Array {
+    return this.take(Float32Array, length);
+  }
+
+  place(values: Float32Array): Float32Array {
+    const a = this.take(Float32Array, values.length);
+    a.set(values);
+    return a;
+  }
+
+  placeInts(values: Int32Array): Int32Array {
+    const a = this.take(Int32Array, values.length);
+    a.set(values);
+    return a;
+  }
+
+  scratch(length: number): Float64Array {
+    return this.take(Float64Array, length);
+  }
+
+  pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight {
+    if (outs % 4) return { outs, cols, w: W, b }; // matmul() uses the TypeScript product for these
+    const w = this.alloc(outs * cols);
+    for (let o = 0; o < outs; o++) for (let i = 0; i < cols; i++) w[i * outs + o] = W[o * cols + i];
+    return { outs, cols, w, b: this.place(b) };
+  }
+
+  private mine(...arrays: ArrayBufferView[]): void {
+    for (const a of arrays) {
+      if (a.buffer !== this.exports.memory.buffer) throw new Error('SimdKernel: an array not allocated by this kernel');
+    }
+  }
+
+  matmul(p: PackedWeight, X: Float32Array, rows: number, out: Float32Array): void {
+    if (p.outs % 4) {
+      matmulRows(p.w, p.b, p.outs, p.cols, X, rows, out);
+      return;
+    }
+    if (rows % 2) throw new Error('SimdKernel.matmul: rows must be even');
+    this.mine(X, out);
+    this.exports.matmul(p.w.byteOffset, p.b.byteOffset, p.outs, p.cols, X.byteOffset, rows, out.byteOffset);
+  }
+
+  layerNorm(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, eps: number): void {
+    this.mine(X, g, b, out);
+    this.exports.layer_norm(X.byteOffset, rows, d, g.byteOffset, b.byteOffset, out.byteOffset, eps);
+  }
+
+  attention(qkv: Float32Array, tokens: number, d: number, heads: number, keyStart: Int32Array, keyIndex: Int32Array,
+    scores: Float64Array, out: Float32Array): void {
+    if ((d / heads) % 4) throw new Error('SimdKernel.attention: the head size must be a multiple of 4');
+    this.mine(qkv, keyStart, keyIndex, scores, out);
+    this.exports.attention(qkv.byteOffset, tokens, d, heads, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset,
+      out.byteOffset, 1 / Math.sqrt(d / heads));
+  }
+
+  gelu(a: Float32Array, count: number): void {
+    this.mine(a);
+    this.exports.gelu(a.byteOffset, count, this.geluValue.byteOffset, this.geluSlope.byteOffset, GELU_RANGE, GELU_STEPS);
+  }
+
+  add(x: Float32Array, y: Float32Array, count: number): void {
+    this.mine(x, y);
+    this.exports.add(x.byteOffset, y.byteOffset, count);
+  }
+}

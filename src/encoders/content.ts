@@ -1,0 +1,94 @@
+/**
+ * The content branch (paper Fig. 2, "audio encoder"): log-Mel -> content encoder (ONNX, phone logits every
+ * content_stride Mel frames) -> softmax -> each animation frame's window of posteriors -> the hierarchical
+ * encoder (ONNX) -> one token per vertex. The model's stand-in for DeepSpeech: what it heard, per frame.
+ */
+import type { Manifest, ModelConstants } from '../model/manifest';
+import { contentWindows, softmaxRows } from './windows';
+import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
+
+/** Content frames [lo, hi) and the Mel frames [melLo, melHi) that compute them exactly. */
+export interface ContentRange {
+  lo: number;
+  hi: number;
+  melLo: number;
+  melHi: number;
+}
+
+export class ContentEncoder {
+  private readonly m: ModelConstants;
+
+  private constructor(
+    private readonly manifest: Manifest,
+    private readonly content: OnnxModel,
+    private readonly hierarchical: OnnxModel,
+  ) {
+    this.m = manifest.model.config;
+  }
+
+  static async create(manifest: Manifest, files: Record<string, ArrayBuffer>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
+    const [content, hierarchical] = await Promise.all([
+      OnnxModel.create(specOf(manifest, 'content_encoder', files.content_encoder), providers),
+      OnnxModel.create(specOf(manifest, 'hierarchical', files.hierarchical), providers),
+    ]);
+    return new ContentEncoder(manifest, content, hierarchical);
+  }
+
+  /**
+   * Mel frames of context before a range's first content frame: the encoder's look-back, rounded up to a
+   * whole content frame so the strided convolution lines up with the whole clip.
+   */
+  get melBack(): number {
+    const stride = this.m.content_stride;
+    return Math.ceil(this.manifest.receptive_field.content_mel_frames_back / stride) * stride;
+  }
+
+  /** Mel frames read past a content frame's first Mel frame (its look-ahead), plus one content frame of margin. */
+  get melAhead(): number {
+    return this.manifest.receptive_field.content_mel_frames + this.m.content_stride;
+  }
+
+  /** The content frames the windows of frames at `melIndex` read, and the Mel frames they need (K: Mel frames in the clip). */
+  range(melIndex: number[], K: number): ContentRange {
+    const m = this.m;
+    const Kc = Math.ceil(K / m.content_stride);
+    const lo = Math.max(0, Math.floor(melIndex[0] / m.content_stride) - (m.window - 1 - m.window_future));
+    const hi = Math.min(Kc, Math.floor(melIndex[melIndex.length - 1] / m.content_stride) + m.window_future + 1);
+    const melLo = Math.max(0, lo * m.content_stride - this.melBack);
+    const melHi = Math.min(K, Math.max(hi * m.content_stride, melIndex[melIndex.length - 1] + 1) + this.melAhead);
+    return { lo, hi, melLo, melHi };
+  }
+
+  /** Phone posteriors (content frames r.lo..r.hi x classes) from the Mel frames r.melLo..r.melHi. */
+  async posteriors(mel: Float32Array, r: ContentRange): Promise<Float32Array> {
+    const m = this.m;
+    const logits = (await this.content.run({ mel: { data: mel, shape: [1, r.melHi - r.melLo, this.manifest.audio.n_mels] } })).logits.data;
+    // Content frame j of this run is the clip's content frame melLo / stride + j: melLo is 0 or a multiple
+    // of the stride, so the strided convolution lines up with the whole-clip computation.
+    const runOffset = r.melLo / m.content_stride;
+    return softmaxRows(logits.slice((r.lo - runOffset) * m.content_classes, (r.hi - runOffset) * m.content_classes), m.content_classes);
+  }
+
+  /** Each frame's window of posteriors (frames x window x classes); K: the clip's Mel frames (Infinity while streaming). */
+  windows(post: Float32Array, melIndex: number[], r: ContentRange, K: number): Float32Array {
+    const Kc = Math.ceil(K / this.m.content_stride);
+    return contentWindows(post, melIndex, this.m, r.lo, Number.isFinite(Kc) ? Kc : undefined);
+  }
+
+  /** The most probable content class at each frame's content position (names: manifest.content_phones). */
+  heardPhones(post: Float32Array, melIndex: number[], r: ContentRange): Uint8Array {
+    const { content_stride: stride, content_classes: classes } = this.m;
+    return Uint8Array.from(melIndex, (k) => {
+      const row = (Math.floor(k / stride) - r.lo) * classes;
+      let best = 0;
+      for (let j = 1; j < classes; j++) if (post[row + j] > post[row + best]) best = j;
+      return best;
+    });
+  }
+
+  /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */
+  async tokens(windows: Float32Array, frames: number): Promise<Float32Array> {
+    const m = this.m;
+    return (await this.hierarchical.run({ windows: { data: windows, shape: [frames, m.window, m.content_classes] } })).tokens.data;
+  }
+}

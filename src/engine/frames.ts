@@ -1,0 +1,65 @@
+/** What the engine hands out: frames of a chunk, a whole animation, and how long each stage took. */
+
+/** Frames of one chunk: posed vertices and I + O in the template's units, poses (axis-angle, mm). */
+export interface Frames {
+  count: number;
+  vertices: Float32Array;
+  unposed: Float32Array;
+  pose: Float32Array;
+  /** (count): the content class heard most at each frame (manifest.content_phones). */
+  phones: Uint8Array;
+}
+
+export interface Animation {
+  fps: number;
+  frames: number;
+  /** (frames x N x 3) posed vertices in the template's units, or empty when keep = false. */
+  vertices: Float32Array;
+  /** (frames x 6): axis-angle (rad), translation (mm). */
+  pose: Float32Array;
+  /** (frames x N x 3) I + O in the template's units, when asked for. */
+  unposed?: Float32Array;
+  /** (frames): the content class the encoder heard most at each frame (names: manifest.content_phones). */
+  phones: Uint8Array;
+}
+
+/** Milliseconds spent in each stage since the last resetTimes(). */
+export interface StageTimes {
+  mel: number;
+  content: number;
+  hierarchical: number;
+  pose: number;
+  decoder: number;
+  posing: number;
+}
+
+/** Chunks of streamed frames joined into one animation (they must be consecutive). */
+export function joinFrames(chunks: Frames[], fps: number): Animation {
+  const count = chunks.reduce((s, f) => s + f.count, 0);
+  const per = chunks[0]?.vertices.length / Math.max(1, chunks[0]?.count ?? 1) || 0;
+  const vertices = new Float32Array(count * per);
+  const unposed = new Float32Array(count * per);
+  const pose = new Float32Array(count * 6);
+  const phones = new Uint8Array(count);
+  let i = 0;
+  for (const f of chunks) {
+    vertices.set(f.vertices, i * per);
+    unposed.set(f.unposed, i * per);
+    pose.set(f.pose, i * 6);
+    phones.set(f.phones, i);
+    i += f.count;
+  }
+  return { fps, frames: count, vertices, pose, unposed, phones };
+}
+
+/** Resolve on a new task (not a microtask): lets the browser handle input, rendering and timers. */
+export function yieldToEventLoop(): Promise<void> {
+  return new Promise((resolve) => {
+    const channel = new MessageChannel();
+    channel.port1.onmessage = () => {
+      channel.port1.close();
+      resolve();
+    };
+    channel.port2.postMessage(null);
+  });
+}

@@ -1,0 +1,118 @@
+/**
+ * One chunk of the pipeline (paper Fig. 2): samples -> log-Mel -> content encoder -> windows -> hierarchical
+ * tokens; log-Mel -> pose encoder (state carried) -> pose token; both -> the attention decoder -> posing.
+ *
+ * Every chunk recomputes the Mel and content frames it needs with enough context on each side that the result
+ * equals the whole-clip computation exactly, so memory holds one chunk of intermediates whatever the clip's length.
+ */
+import { frameToMelIndex, type Manifest } from '../model/manifest';
+import { logMelFrames, melFrameCount } from '../audio/mel';
+import type { ContentEncoder } from '../encoders/content';
+import type { PoseEncoder, PoseState } from '../encoders/pose';
+import type { DecoderBackends } from './backends';
+import { poseFrames } from '../pose/posing';
+import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
+import type { Frames, StageTimes } from './frames';
+
+/** Frames per chunk when the caller does not say: bounds memory and the WebGPU decoder's buffers. */
+export const DEFAULT_CHUNK_FRAMES = 96;
+
+/** What carries from one chunk to the next (the pose encoder's LSTM state and features). */
+export type ProducerState = PoseState;
+
+export class Pipeline {
+  readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
+  readonly mmPerUnit: number;
+  readonly templateMm: Float32Array;
+
+  constructor(
+    readonly manifest: Manifest,
+    readonly template: FaceTemplate,
+    readonly content: ContentEncoder,
+    readonly pose: PoseEncoder,
+    readonly decoders: DecoderBackends,
+  ) {
+    this.mmPerUnit = MM_PER_UNIT[template.units];
+    this.templateMm = Float32Array.from(template.positions, (v) => v * this.mmPerUnit);
+  }
+
+  get fps(): number {
+    return this.manifest.audio.fps;
+  }
+
+  /** Frames produced for `samples` samples: round(duration * fps). */
+  frameCount(samples: number): number {
+    return Math.max(1, Math.round((samples / this.manifest.audio.sample_rate) * this.fps));
+  }
+
+  /** Samples a frame needs before it can be computed exactly (its receptive field's last sample, exclusive). */
+  samplesNeeded(frame: number): number {
+    const a = this.manifest.audio;
+    const m = this.manifest.model.config;
+    const r = this.manifest.receptive_field;
+    const mel = frameToMelIndex(frame, a);
+    const lastContent = Math.floor(mel / m.content_stride) + m.window_future;
+    const lastMel = Math.max(lastContent * m.content_stride + r.content_mel_frames, mel + r.pose_mel_frames);
+    return lastMel * a.hop + a.frame_size / 2;
+  }
+
+  /** Audio samples before frame `next`'s Mel frame that no later frame reads (for a stream to forget). */
+  samplesBehind(next: number): number {
+    const { audio: a, model } = this.manifest;
+    const back = (model.config.window - model.config.window_future) * model.config.content_stride + this.content.melBack;
+    return Math.max(0, (frameToMelIndex(next, a) - back) * a.hop - a.frame_size);
+  }
+
+  newState(): ProducerState {
+    return this.pose.newState();
+  }
+
+  /**
+   * Frames [f0, f1) of a signal of `total` samples (Infinity while streaming), of which `samples` holds
+   * [offset, offset + samples.length). Exact whenever the samples cover every frame's receptive field.
+   * `inputs` receives the decoder's inputs (vertex and pose tokens) when given.
+   */
+  async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number,
+    inputs?: { tokens?: Float32Array; poseToken?: Float32Array }): Promise<Frames> {
+    const a = this.manifest.audio;
+    const K = Number.isFinite(total) ? melFrameCount(total, a) : Infinity;
+    const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));
+    const signalEnd = Number.isFinite(total) ? total : offset + samples.length;
+    const range = this.content.range(melIndex, K);
+    let t = performance.now();
+    const mel = logMelFrames(samples, a, range.melLo, range.melHi - range.melLo, undefined, offset, signalEnd);
+    this.times.mel += performance.now() - t;
+
+    t = performance.now();
+    const post = await this.content.posteriors(mel, range);
+    const windows = this.content.windows(post, melIndex, range, K);
+    const phones = this.content.heardPhones(post, melIndex, range);
+    this.times.content += performance.now() - t;
+
+    t = performance.now();
+    const tokens = await this.content.tokens(windows, melIndex.length);
+    this.times.hierarchical += performance.now() - t;
+
+    // Pose: the LSTM advances over every Mel frame up to this chunk's last one, exactly once.
+    t = performance.now();
+    const melOf = (lo: number, hi: number) => lo >= range.melLo && hi <= range.melHi
+      ? mel.subarray((lo - range.melLo) * a.n_mels, (hi - range.melLo) * a.n_mels)
+      : logMelFrames(samples, a, lo, hi - lo, undefined, offset, signalEnd);
+    await this.pose.advance(state, melIndex[melIndex.length - 1] + 1, melIndex[0], K, melOf);
+    const poseToken = this.pose.tokens(state, melIndex);
+    this.times.pose += performance.now() - t;
+
+    if (inputs) {
+      inputs.tokens = tokens;
+      inputs.poseToken = poseToken;
+    }
+    t = performance.now();
+    const decoded = await this.decoders.decode(tokens, poseToken, melIndex.length, this.template.vertexCount);
+    this.times.decoder += performance.now() - t;
+
+    t = performance.now();
+    const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
+    this.times.posing += performance.now() - t;
+    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+  }
+}

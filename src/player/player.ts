@@ -1,0 +1,165 @@
+/**
+ * The one player the demo and <talking-face> share: it shows a frame of a take on a FaceView (unposed face plus
+ * head pose), plays the take's audio with the face in sync on the AudioContext's clock, shows streamed frames
+ * live, and says what is worth knowing about the audio (silence, clipping, length).
+ */
+import type { FaceView } from '../render/face-view';
+import type { Animation, Frames } from '../engine/frames';
+import { levels } from '../audio/decode';
+
+/** Longer clips get a note with the expected time (they still work: memory stays bounded). */
+export const LONG_CLIP_SECONDS = 120;
+
+/** Notes for a person about a clip's audio: silent, clipped, long. Empty when there is nothing to say. */
+export function audioNotes(samples: Float32Array, seconds: number): string[] {
+  const lv = levels(samples);
+  const notes: string[] = [];
+  if (lv.peak < 1e-3) notes.push('the audio is silent, so the mouth stays closed');
+  if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of the samples are clipped (distorted); the motion may be less accurate`);
+  if (seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it is animated in chunks with bounded memory; Cancel stops it`);
+  return notes;
+}
+
+export interface PlayerOptions {
+  /** Called whenever a frame of the take is shown (by play, seek or show). */
+  onFrame?: (frame: number) => void;
+  /** Called when playback reaches the end (not on stop(), not when looping). */
+  onEnded?: () => void;
+}
+
+interface Playing {
+  source: AudioBufferSourceNode;
+  startedAt: number;
+  fromFrame: number;
+  finish: () => void;
+}
+
+export class Player {
+  /** Start again from the first frame when the end is reached. */
+  loop = false;
+  private animation: Animation | null = null;
+  private buffer: AudioBuffer | null = null;
+  private shape: ((frame: number, unposed: Float32Array) => Float32Array) | null = null;
+  private context: AudioContext | null = null;
+  private playing: Playing | null = null;
+  private currentFrame = 0;
+
+  /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
+  constructor(private readonly view: FaceView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
+
+  /**
+   * A new take to show and play. `shape` maps frame f's unposed face to what is drawn (e.g. onto another
+   * subject's face); by default it is drawn as is. The animation must carry `unposed` frames.
+   */
+  load(animation: Animation, buffer: AudioBuffer, shape?: (frame: number, unposed: Float32Array) => Float32Array): void {
+    if (!animation.unposed) throw new Error('Player: the animation has no unposed frames (animate with { unposed: true })');
+    this.stop();
+    this.animation = animation;
+    this.buffer = buffer;
+    this.shape = shape ?? null;
+    this.currentFrame = 0;
+  }
+
+  get take(): Animation | null {
+    return this.animation;
+  }
+
+  get current(): number {
+    return this.currentFrame;
+  }
+
+  get isPlaying(): boolean {
+    return this.playing !== null;
+  }
+
+  /** Show frame `frame` of the take (clamped to it). */
+  show(frame: number): void {
+    const a = this.animation;
+    if (!a?.unposed) return;
+    const n3 = a.unposed.length / a.frames;
+    const f = Math.min(Math.max(0, Math.floor(frame)), a.frames - 1);
+    this.currentFrame = f;
+    const unposed = a.unposed.subarray(f * n3, (f + 1) * n3);
+    this.view.setVertices(this.shape ? this.shape(f, unposed) : unposed);
+    this.pose(a.pose.subarray(f * 6, f * 6 + 6));
+    this.options.onFrame?.(f);
+  }
+
+  /** Show the last frame of a streamed chunk (live). */
+  showLive(frames: Frames): void {
+    const last = frames.count - 1;
+    const n3 = frames.unposed.length / frames.count;
+    this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
+    this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
+  }
+
+  private pose(p: Float32Array): void {
+    const s = this.unitsPerMm;
+    this.view.setPose(p[0], p[1], p[2], p[3] * s, p[4] * s, p[5] * s);
+  }
+
+  /**
+   * Play from `from` (default: the current frame, or the start when at the end) with the face in sync.
+   * Resolves when playback ends or is stopped.
+   */
+  play(from?: number): Promise<void> {
+    const a = this.animation;
+    if (!a || !this.buffer) return Promise.resolve();
+    this.stop();
+    const start = from ?? (this.currentFrame >= a.frames - 1 ? 0 : this.currentFrame);
+    this.context ??= new AudioContext();
+    const context = this.context;
+    // Deliberate: resume() rejects only when the context is closed, and then start() below throws with the reason.
+    void context.resume().catch(() => undefined); // rejects only on a closed context; start() then throws why
+    return new Promise<void>((resolve) => {
+      const source = context.createBufferSource();
+      source.buffer = this.buffer;
+      source.connect(context.destination);
+      const startedAt = context.currentTime + 0.05;
+      const playing: Playing = { source, startedAt, fromFrame: start, finish: resolve };
+      source.onended = () => {
+        if (this.playing !== playing) return;
+        this.playing = null;
+        if (this.loop) {
+          this.show(0);
+          void this.play(0).then(resolve);
+          return;
+        }
+        this.show(a.frames - 1);
+        resolve();
+        this.options.onEnded?.();
+      };
+      source.start(startedAt, start / a.fps);
+      this.playing = playing;
+      let last = -1;
+      const tick = () => {
+        if (this.playing !== playing || this.animation !== a) return;
+        const f = playing.fromFrame + Math.floor((context.currentTime - playing.startedAt) * a.fps);
+        if (f !== last && f >= playing.fromFrame && f < a.frames) {
+          last = f;
+          this.show(f);
+        }
+        requestAnimationFrame(tick);
+      };
+      requestAnimationFrame(tick);
+    });
+  }
+
+  /** Stop playback (the face keeps the frame it shows). */
+  stop(): void {
+    const p = this.playing;
+    if (!p) return;
+    this.playing = null;
+    p.source.onended = null;
+    p.source.stop();
+    p.finish();
+  }
+
+  /** Stop and release the audio output. */
+  dispose(): void {
+    this.stop();
+    // Deliberate: closing an AudioContext fails only if it is already closed, which is the goal.
+    void this.context?.close().catch(() => undefined); // fails only when already closed: the goal
+    this.context = null;
+  }
+}

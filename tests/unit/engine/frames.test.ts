@@ -1,0 +1,37 @@
+/** joinFrames (src/engine/frames.ts): streamed chunks become one animation, every array in order. */
+import { describe, expect, it } from 'vitest';
+import { joinFrames, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
+
+const chunk = (first: number, count: number, n: number): Frames => ({
+  count,
+  vertices: Float32Array.from({ length: count * n * 3 }, (_, i) => first * n * 3 + i),
+  unposed: Float32Array.from({ length: count * n * 3 }, (_, i) => -(first * n * 3 + i)),
+  pose: Float32Array.from({ length: count * 6 }, (_, i) => first * 6 + i),
+  phones: Uint8Array.from({ length: count }, (_, i) => first + i),
+});
+
+describe('joinFrames', () => {
+  it('concatenates chunks of any size', () => {
+    const a = joinFrames([chunk(0, 3, 2), chunk(3, 1, 2), chunk(4, 5, 2)], 30);
+    expect(a.frames).toBe(9);
+    expect(a.fps).toBe(30);
+    expect(Array.from(a.vertices)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => i));
+    expect(Array.from(a.unposed!)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => -i));
+    expect(Array.from(a.pose)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => i));
+    expect(Array.from(a.phones)).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
+  });
+
+  it('no chunks make an empty animation', () => {
+    expect(joinFrames([], 30).frames).toBe(0);
+  });
+
+  it('yieldToEventLoop resolves after timers already due (a new task, not a microtask)', async () => {
+    const order: string[] = [];
+    setTimeout(() => order.push('timer'), 0);
+    await new Promise((r) => setTimeout(r, 5));
+    const p = yieldToEventLoop().then(() => order.push('yield'));
+    void Promise.resolve().then(() => order.push('microtask'));
+    await p;
+    expect(order).toEqual(['timer', 'microtask', 'yield']);
+  });
+});

@@ -1,0 +1,48 @@
+/**
+ * WebGPU probing (src/gpu/capabilities.ts) with stand-in navigator.gpu objects: every way there can be no adapter
+ * gets its own reason, a software adapter says so, the answer is shared, and a failed device request is retried.
+ */
+import { afterEach, describe, expect, it, vi } from 'vitest';
+
+type Capabilities = typeof import('../../../src/gpu/capabilities');
+
+async function fresh(gpu: unknown): Promise<Capabilities> {
+  vi.resetModules();
+  vi.stubGlobal('navigator', gpu === undefined ? {} : { gpu });
+  return import('../../../src/gpu/capabilities');
+}
+
+const adapter = (info: Record<string, unknown>, requestDevice = vi.fn()) => ({ info, requestDevice });
+
+afterEach(() => vi.unstubAllGlobals());
+
+describe('detectWebGPU', () => {
+  it('no navigator.gpu, a failing request, no adapter: each says why', async () => {
+    expect((await (await fresh(undefined)).detectWebGPU()).description).toMatch(/navigator.gpu is missing/);
+    const failing = await fresh({ requestAdapter: () => Promise.reject(new Error('blocked by policy')) });
+    expect(await failing.detectWebGPU()).toMatchObject({ available: false, description: expect.stringMatching(/blocked by policy/) });
+    expect((await (await fresh({ requestAdapter: async () => null })).detectWebGPU()).description).toMatch(/no adapter/);
+  });
+
+  it('names the adapter, marks a software one, and asks the browser once', async () => {
+    const requestAdapter = vi.fn(async () => adapter({ vendor: 'google', architecture: 'swiftshader', device: '', isFallbackAdapter: true }));
+    const m = await fresh({ requestAdapter });
+    const [a, b] = await Promise.all([m.detectWebGPU(), m.detectWebGPU()]);
+    expect(a).toBe(b);
+    expect(requestAdapter).toHaveBeenCalledTimes(1);
+    expect(a.description).toBe('google swiftshader (fallback adapter, software)');
+    expect(a.info?.isFallbackAdapter).toBe(true);
+  });
+
+  it('shares one device, and retries after a failed device request', async () => {
+    const device = { lost: new Promise(() => undefined) };
+    const requestDevice = vi.fn().mockRejectedValueOnce(new Error('out of memory')).mockResolvedValue(device);
+    const m = await fresh({ requestAdapter: async () => adapter({ vendor: 'acme', architecture: 'x', device: 'y' }, requestDevice) });
+    await expect(m.requestSharedDevice()).rejects.toThrow(/out of memory/);
+    await new Promise((r) => setTimeout(r, 0));
+    const [d1, d2] = await Promise.all([m.requestSharedDevice(), m.requestSharedDevice()]);
+    expect(d1).toBe(device);
+    expect(d2).toBe(device);
+    expect(requestDevice).toHaveBeenCalledTimes(2);
+  });
+});

@@ -1,0 +1,142 @@
+/**
+ * The shared player (src/player/player.ts) on a stand-in face view and audio clock: which frame it shows, where
+ * the pose goes, the shape mapping, play / stop / end / loop, and the notes it writes about a clip's audio.
+ */
+import { afterEach, beforeEach, describe, expect, it } from 'vitest';
+import { Player, audioNotes, LONG_CLIP_SECONDS } from '../../../src/player/player';
+import type { FaceView } from '../../../src/render/face-view';
+import type { Animation } from '../../../src/engine/frames';
+
+/** A face view that records what it was given. */
+function fakeView() {
+  const shown: { vertices: number[]; pose: number[] }[] = [];
+  let last: number[] = [];
+  const view = {
+    setVertices: (v: Float32Array) => (last = Array.from(v)),
+    setPose: (...p: number[]) => shown.push({ vertices: last, pose: p }),
+  } as unknown as FaceView;
+  return { view, shown };
+}
+
+/** Two vertices, `frames` frames: vertex values f, poses f (rotation) and 10 f (mm). */
+function animation(frames: number): Animation {
+  return {
+    fps: 10, frames,
+    vertices: new Float32Array(frames * 6),
+    unposed: Float32Array.from({ length: frames * 6 }, (_, i) => Math.floor(i / 6)),
+    pose: Float32Array.from({ length: frames * 6 }, (_, i) => (i % 6 < 3 ? Math.floor(i / 6) : 10 * Math.floor(i / 6))),
+    phones: new Uint8Array(frames),
+  };
+}
+
+/** An AudioContext whose clock the test moves, and requestAnimationFrame driven by the test. */
+class FakeContext {
+  static last: FakeContext;
+  currentTime = 0;
+  destination = {};
+  sources: { onended: (() => void) | null; started: number[]; stopped: boolean }[] = [];
+  constructor() {
+    FakeContext.last = this;
+  }
+  resume() { return Promise.resolve(); }
+  close() { return Promise.resolve(); }
+  createBufferSource() {
+    const s = { buffer: null, onended: null as (() => void) | null, started: [] as number[], stopped: false,
+      connect() {}, start(...a: number[]) { s.started = a; }, stop() { s.stopped = true; } };
+    this.sources.push(s);
+    return s;
+  }
+}
+let frameCallbacks: (() => void)[] = [];
+const tick = () => {
+  const cbs = frameCallbacks;
+  frameCallbacks = [];
+  for (const cb of cbs) cb();
+};
+
+beforeEach(() => {
+  Object.assign(globalThis, { AudioContext: FakeContext, requestAnimationFrame: (cb: () => void) => frameCallbacks.push(cb) });
+});
+afterEach(() => {
+  frameCallbacks = [];
+});
+
+describe('Player', () => {
+  it('shows a frame (clamped) with its pose, translations in the template units', () => {
+    const { view, shown } = fakeView();
+    const seen: number[] = [];
+    const p = new Player(view, 0.1, { onFrame: (f) => seen.push(f) });
+    p.load(animation(5), {} as AudioBuffer);
+    p.show(3);
+    p.show(99);
+    expect(seen).toEqual([3, 4]);
+    expect(shown[0]).toEqual({ vertices: [3, 3, 3, 3, 3, 3], pose: [3, 3, 3, 3, 3, 3] }); // 30 mm x 0.1 units per mm
+    expect(p.current).toBe(4);
+  });
+
+  it('draws through the shape mapping when given one', () => {
+    const { view, shown } = fakeView();
+    const p = new Player(view, 1);
+    p.load(animation(3), {} as AudioBuffer, (f, u) => Float32Array.from(u, (v) => v + 100 * f));
+    p.show(2);
+    expect(shown[0].vertices).toEqual([202, 202, 202, 202, 202, 202]);
+  });
+
+  it('plays in sync with the audio clock, stops, and reports the natural end', async () => {
+    const { view } = fakeView();
+    const seen: number[] = [];
+    let ended = 0;
+    const p = new Player(view, 1, { onFrame: (f) => seen.push(f), onEnded: () => ended++ });
+    p.load(animation(20), {} as AudioBuffer);
+    const done = p.play();
+    const ctx = FakeContext.last;
+    expect(p.isPlaying).toBe(true);
+    ctx.currentTime = 0.05 + 0.75; // 0.75 s after the scheduled start: frame 7
+    tick();
+    expect(seen[seen.length - 1]).toBe(7);
+    ctx.sources[0].onended!();
+    await done;
+    expect(ended).toBe(1);
+    expect(seen[seen.length - 1]).toBe(19); // the last frame is left on screen
+    expect(p.isPlaying).toBe(false);
+    // Play again from frame 5; stop() resolves it without an end.
+    const again = p.play(5);
+    expect(ctx.sources[1].started).toEqual([ctx.currentTime + 0.05, 0.5]);
+    p.stop();
+    await again;
+    expect(ctx.sources[1].stopped).toBe(true);
+    expect(ended).toBe(1);
+  });
+
+  it('loops when asked', async () => {
+    const { view } = fakeView();
+    let ended = 0;
+    const p = new Player(view, 1, { onEnded: () => ended++ });
+    p.loop = true;
+    p.load(animation(4), {} as AudioBuffer);
+    void p.play();
+    const ctx = FakeContext.last;
+    ctx.sources[0].onended!();
+    expect(ctx.sources.length).toBe(2); // started again from the start
+    expect(ctx.sources[1].started[1]).toBe(0);
+    expect(ended).toBe(0);
+    p.stop();
+  });
+
+  it('refuses an animation without unposed frames', () => {
+    const a = animation(2);
+    delete a.unposed;
+    expect(() => new Player(fakeView().view, 1).load(a, {} as AudioBuffer)).toThrow(/unposed/);
+  });
+});
+
+describe('audioNotes', () => {
+  it('says silent, clipped and long, and nothing for ordinary speech', () => {
+    const speech = Float32Array.from({ length: 16000 }, (_, i) => 0.3 * Math.sin(i / 7));
+    expect(audioNotes(speech, 1)).toEqual([]);
+    expect(audioNotes(new Float32Array(16000), 1).join()).toMatch(/silent/);
+    const clipped = Float32Array.from(speech, (v) => Math.max(-1, Math.min(1, v * 10)));
+    expect(audioNotes(clipped, 1).join()).toMatch(/clipped/);
+    expect(audioNotes(speech, LONG_CLIP_SECONDS + 1).join()).toMatch(/long clip/);
+  });
+});

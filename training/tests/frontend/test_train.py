@@ -1,0 +1,41 @@
+"""The front-end's trainer: its augmentation keeps labels aligned, it learns, and the face model takes it frozen."""
+import json
+
+import numpy as np
+import torch
+
+from talkingface.frontend import train as fe_train
+from talkingface.phones import PHONE_INDEX
+from talkingface.train import train
+
+
+def test_warp_moves_energy_up_the_mel_axis():
+    mel = np.zeros((3, 80), np.float32)
+    mel[:, 20] = 1.0
+    assert np.argmax(fe_train.warp(mel, 1.1)[0]) == 22 and np.argmax(fe_train.warp(mel, 0.9)[0]) == 18
+    np.testing.assert_array_equal(fe_train.warp(mel, 1.0), mel)
+
+
+def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
+    speech = tmp_path / "speech"
+    speech.mkdir()
+    rows = []
+    rng = np.random.default_rng(0)
+    for i in range(6):  # a toy speech set: noise with two "phones" that differ in level
+        lab = (np.arange(400) // 50 % 2).astype(np.int8) * PHONE_INDEX["M"]
+        mel = (rng.standard_normal((400, 80)) + 3.0 * (lab[:, None] > 0)).astype(np.float16)
+        np.savez(speech / f"s{i}.npz", mel=mel, labels=lab)
+        rows.append({"key": f"s{i}", "seconds": 4.0})
+    (speech / "index.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    out = tmp_path / "fe"
+    fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(out), "--minutes", "0.05",
+                   "--eval-every", "5", "--threads", "1"])
+    ev = json.loads((out / "frontend_eval.json").read_text())
+    assert ev["step"] >= 5 and ev["history"][-1]["loss"] < ev["history"][0]["loss"]
+    fe = torch.load(out / "frontend.pt", weights_only=False)
+    run = tmp_path / "run"
+    train.main(["--corpus", str(corpus.root), "--out", str(run), "--steps", "3", "--batch-clips", "2", "--frames", "4",
+                "--frontend", str(out / "frontend.pt")])
+    model, _ = train.load_checkpoint(run / "final.pt", corpus.template)
+    for k, v in fe["content"].items():  # frozen: the face's training left every front-end weight as it was
+        torch.testing.assert_close(model.content.state_dict()[k], v, rtol=0, atol=0)

@@ -1,0 +1,56 @@
+"""The articulation measures tell a mouth that times its closures from an average one and from one that flaps."""
+import numpy as np
+
+from talkingface.phones import PHONES
+from talkingface.train import articulation as art
+
+FPS = 30
+# A 6 s utterance: pause, then vowels and consonants with a bilabial every 0.6 s.
+PHONES_SEQ = [("SIL", 0.0, 0.3)]
+t = 0.3
+while t < 5.7:
+    PHONES_SEQ += [(p, round(t + a, 4), round(t + b, 4)) for p, a, b in
+                   [("AA", 0, 0.2), ("M", 0.2, 0.3), ("IY", 0.3, 0.45), ("T", 0.45, 0.6)]]  # 4 decimals, as alignments
+    t = round(t + 0.6, 4)
+N = int(6.0 * FPS)
+
+
+def gap_track(closed_on) -> np.ndarray:
+    g = np.full(N, 8.0)
+    for p, a, b in PHONES_SEQ:
+        if closed_on(p, a, b):
+            g[art.segment_frames(a, b, FPS, N)] = 0.0
+    return g
+
+
+def test_timed_closures_score_and_beat_chance():
+    c = art.clip_articulation(gap_track(lambda p, a, b: p == "M"), gap_track(lambda p, a, b: p == "M"), PHONES_SEQ, FPS)
+    s = art.summarise([c])
+    assert s["pred_closure"] == 1.0 and s["pred_false_closure"] == 0.0 and s["pred_open_vowel_opened"] == 1.0
+    assert s["chance_closure"] < 0.5 and s["gap_corr"] > 0.99
+
+
+def test_an_average_mouth_never_closes():
+    truth = gap_track(lambda p, a, b: p == "M")
+    s = art.summarise([art.clip_articulation(truth, np.full(N, truth.mean()), PHONES_SEQ, FPS)])
+    assert s["pred_closure"] == 0.0 and s["gap_corr"] == 0.0 and s["gap_std_ratio"] < 1e-9
+
+
+def test_a_flapping_mouth_shows_its_false_alarms():
+    truth = gap_track(lambda p, a, b: p == "M")
+    flap = np.where(np.arange(N) % 4 < 2, 0.0, 8.0)  # closes every 133 ms, whatever is said
+    s = art.summarise([art.clip_articulation(truth, flap, PHONES_SEQ, FPS)])
+    assert s["pred_closure"] == 1.0
+    assert s["pred_false_closure"] > 0.8 and s["chance_closure"] > 0.8  # it scores no better than chance
+
+
+def test_content_confusion_and_bilabials_heard():
+    labels = np.array([PHONES.index(p) for p in ["SIL", "P", "P", "AA", "AA", "M", "M", "T", "B"]])
+    called = ["SIL", "T", "P", "AA", "AH", "K", "K", "T", "SIL"]
+    logits = np.full((len(labels), len(PHONES) + 1), -5.0)
+    logits[np.arange(len(labels)), [PHONES.index(p) for p in called]] = 5.0
+    conf = art.content_counts(logits, labels, len(PHONES) + 1)
+    s = art.content_summary(conf, art.bilabial_heard(logits, labels))
+    assert s["frame_accuracy"] == 4 / 9
+    assert s["bilabial_segments"] == 3 and s["bilabial_segments_heard"] == 1 / 3  # P heard once; M and B missed
+    assert s["recall"]["M"]["recall"] == 0.0 and s["recall"]["M"]["mistaken_for"] == ["K"]
