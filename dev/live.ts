@@ -27,11 +27,13 @@ async function main() {
   const n = engine.template.vertexCount;
   const { lips_inner_upper: upper, lips_inner_lower: lower } = engine.template.regions;
   const streamed: Float32Array[] = [];
+  const poses: number[] = [];
   const gaps: number[] = [];
   const contour: number[] = [];
   const media = await openMicrophone();
   const live = await engine.listen(media, (_, frames) => {
     streamed.push(frames.vertices.slice());
+    poses.push(...frames.pose);
     gaps.push(...lipGaps(frames.unposed, frames.count, n, upper, lower));
     contour.push(...innerLipGaps(frames.unposed, frames.count, n, upper, lower));
   }, { maxLagFrames: Infinity }); // every frame, so the stream can be compared with the offline animation
@@ -48,6 +50,13 @@ async function main() {
   let diff = 0;
   for (let i = 0; i < all.length; i++) diff = Math.max(diff, Math.abs(all[i] - offline.vertices[i]));
   const peak = take.reduce((m, v) => Math.max(m, Math.abs(v)), 0);
+  // ?head=1: the streamed head rotation (degrees, frames x 3), and the same take with the pose head's mean pose alone.
+  const degrees = (pose: ArrayLike<number>) => Array.from({ length: pose.length / 6 * 3 }, (_, i) => (pose[6 * Math.floor(i / 3) + (i % 3)] * 180) / Math.PI);
+  let meanHead: number[] | undefined;
+  if (params.get('head')) {
+    engine.headMotionSeed = null;
+    meanHead = degrees((await engine.animate(take)).pose);
+  }
   return {
     capturedSeconds: take.length / engine.manifest.audio.sample_rate,
     peak,
@@ -62,6 +71,9 @@ async function main() {
     contourGaps: contour,
     // ?take=1: the captured samples too, so a test can find where in the played file the take began.
     take: params.get('take') ? Array.from(take) : undefined,
+    head: params.get('head') ? degrees(poses) : undefined,
+    meanHead,
+    hasHeadMotion: engine.hasHeadMotion,
   };
 }
 

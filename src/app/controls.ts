@@ -23,6 +23,7 @@ export const ui = {
   legend: $<HTMLParagraphElement>('legend'),
   exportGlbButton: $<HTMLButtonElement>('export-glb'),
   exportRawButton: $<HTMLButtonElement>('export-raw'),
+  headRerollButton: $<HTMLButtonElement>('head-reroll'),
   stage: $<HTMLElement>('stage'),
   dropHint: $<HTMLParagraphElement>('drop-hint'),
   timeline: $<HTMLCanvasElement>('timeline'),
@@ -57,6 +58,8 @@ export interface ControlActions {
   setBackend(choice: string): void;
   exportGlb(): void;
   exportRaw(): void;
+  /** Draw the head's own motion again with another seed. */
+  rerollHead(): void;
 }
 
 export function bindControls(a: ControlActions): void {
@@ -72,6 +75,7 @@ export function bindControls(a: ControlActions): void {
   });
   ui.exportGlbButton.addEventListener('click', () => a.exportGlb());
   ui.exportRawButton.addEventListener('click', () => a.exportRaw());
+  ui.headRerollButton.addEventListener('click', () => a.rerollHead());
   ui.fileInput.addEventListener('change', () => {
     const file = ui.fileInput.files?.[0];
     if (file) a.openFile(file);

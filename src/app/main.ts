@@ -159,6 +159,7 @@ function setTake(t: Take, notes: string[] = []): Take {
   showStatus(`${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${perFrame.toFixed(1)} ms per frame, ` +
     `${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time.` + (notes.length ? ` Note: ${notes.join('; ')}.` : ''));
   for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = false;
+  ui.headRerollButton.disabled = !engine?.hasHeadMotion;
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
   player.show(0);
@@ -178,6 +179,21 @@ async function loadSamples(): Promise<void> {
     ui.sampleSelect.disabled = true;
     ui.sampleSelect.title = `No sample clips: ${(e as Error).message}`;
   }
+}
+
+/** The same take with the head's own motion drawn again (the lips and eyes do not change). */
+function rerollHead(): Promise<void> {
+  const t = take;
+  if (!t || !engine?.hasHeadMotion) return Promise.resolve();
+  return animateTake(t.name, async (e, signal) => {
+    e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
+    const t0 = performance.now();
+    const animation = await e.animate(t.samples, { unposed: true, signal });
+    setTake({ ...t, animation, computeMs: performance.now() - t0, lipError: undefined });
+    showStatus(`${ui.status.textContent} Head motion drawn with seed ${e.headMotionSeed}.`);
+    document.body.dataset.headSeed = String(e.headMotionSeed);
+    return take;
+  });
 }
 
 function play(): void {
@@ -271,6 +287,7 @@ bindControls({
   },
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
+  rerollHead: () => void rerollHead(),
 });
 
 start().catch((e: Error) => {

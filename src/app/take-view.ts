@@ -6,7 +6,7 @@ import { FaceView } from '../render/face-view';
 import { lipMask as lipMaskOf } from '../template/face-template';
 import { innerLipGaps } from '../template/lip-gap';
 import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
-import { LipTimeline } from './timeline';
+import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
 import { showLegend, ui } from './controls';
@@ -58,7 +58,11 @@ export class TakeView {
     if (!a.unposed) return this.timeline.clear();
     const { lips_inner_upper: upper, lips_inner_lower: lower } = this.view.template.regions;
     const gap = innerLipGaps(a.unposed, a.frames, this.view.template.vertexCount, upper, lower).map((g) => g / engine.unitsPerMm);
-    this.timeline.show({ fps: a.fps, gap, heard: Array.from(a.phones, (k) => engine.manifest.content_phones[k]), truthGap: take.truth?.lipGapMm, truthPhones: take.truth?.phones });
+    const truth = take.truth;
+    this.timeline.show({
+      fps: a.fps, gap, heard: Array.from(a.phones, (k) => engine.manifest.content_phones[k]), truthGap: truth?.lipGapMm, truthPhones: truth?.phones,
+      head: headDegrees(a.pose, a.frames), truthHead: truth ? headDegrees(truth.pose, truth.frames) : undefined,
+    });
   }
 
   /** After the player shows frame f: the truth beside it, the timeline, scrubber and time, the paint. */

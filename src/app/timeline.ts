@@ -1,6 +1,7 @@
 /**
- * The strip under the face (issue 14): the predicted inner-lip gap over the clip, the phones the content
- * encoder heard, and for sample clips the truth's gap and aligned phones; a playhead follows playback.
+ * The strip under the face: the predicted inner-lip gap over the clip, the phones the content encoder heard
+ * (issue 14), and below them the head's rotation about its three axes (issue 15); for sample clips the truth's
+ * gap, aligned phones and head rotation beside them. A playhead follows playback.
  * The curves are drawn once per clip into an offscreen canvas; moving the playhead only copies it back.
  */
 export interface TimelineData {
@@ -12,11 +13,23 @@ export interface TimelineData {
   /** The truth for sample clips: its gap per frame (mm) and its aligned phones [phone, start s, end s]. */
   truthGap?: ArrayLike<number>;
   truthPhones?: [string, number, number][];
+  /** The head's rotation per frame, degrees (frames x 3: pitch, yaw, roll), and the truth's for sample clips. */
+  head?: Float32Array;
+  truthHead?: Float32Array;
+}
+
+/** Head rotation per frame in degrees (frames x 3) from poses (frames x 6: rotation vector in radians, translation). */
+export function headDegrees(pose: Float32Array, frames: number): Float32Array {
+  const out = new Float32Array(frames * 3);
+  for (let f = 0; f < frames; f++) for (let k = 0; k < 3; k++) out[3 * f + k] = (pose[6 * f + k] * 180) / Math.PI;
+  return out;
 }
 
 const BILABIALS = new Set(['P', 'B', 'M']);
 const CLOSED_MM = 1; // as the articulation measures (training/src/talkingface/train/articulation.py)
 const COLOURS = { back: '#161a23', grid: '#2a3142', pred: '#8fb3ff', truth: '#9aa3b5', bilabial: '#ff8f7a', text: '#c8cedc' };
+/** Pitch, yaw, roll. */
+const AXIS_COLOURS = ['#ffb86b', '#7ee0a1', '#d59bff'];
 
 export class LipTimeline {
   private readonly offscreen = document.createElement('canvas');
@@ -81,7 +94,8 @@ export class LipTimeline {
     const dpr = devicePixelRatio;
     const labelRow = 14 * dpr;
     const top = d.truthPhones ? labelRow : 2 * dpr;
-    const bottom = h - labelRow;
+    const headBand = d.head ? Math.round(0.38 * h) : 0;
+    const bottom = h - labelRow - headBand;
     const maxGap = Math.max(8, ...d.gap, ...(d.truthGap ? Array.from(d.truthGap) : []));
     const y = (mm: number) => bottom - (Math.max(0, mm) / maxGap) * (bottom - top);
     ctx.fillStyle = COLOURS.back;
@@ -113,6 +127,38 @@ export class LipTimeline {
     for (const [p, a, b] of d.truthPhones ?? []) {
       if (p !== 'SIL') this.label(ctx, p, this.x(((a + b) / 2) * d.fps, w), labelRow / 2);
     }
+    if (d.head) this.drawHead(ctx, w, h - headBand, h, d);
+  }
+
+  /** The head's three angles in the band [top, bottom): predicted solid, truth thin; the scale is symmetric about 0. */
+  private drawHead(ctx: CanvasRenderingContext2D, w: number, top: number, bottom: number, d: TimelineData): void {
+    const dpr = devicePixelRatio;
+    let max = 2;
+    for (const v of [d.head!, d.truthHead ?? new Float32Array(0)]) for (const x of v) max = Math.max(max, Math.abs(x));
+    const mid = (top + bottom) / 2;
+    const y = (deg: number) => mid - (deg / max) * ((bottom - top) / 2 - dpr);
+    ctx.fillStyle = COLOURS.grid;
+    ctx.fillRect(0, top, w, dpr);
+    ctx.fillRect(0, Math.round(mid), w, dpr);
+    const curve = (values: Float32Array, k: number, width: number, alpha: number) => {
+      ctx.strokeStyle = AXIS_COLOURS[k];
+      ctx.globalAlpha = alpha;
+      ctx.lineWidth = width * dpr;
+      ctx.beginPath();
+      for (let f = 0; f < values.length / 3; f++) {
+        if (f === 0) ctx.moveTo(this.x(f, w), y(values[3 * f + k]));
+        else ctx.lineTo(this.x(f, w), y(values[3 * f + k]));
+      }
+      ctx.stroke();
+      ctx.globalAlpha = 1;
+    };
+    for (let k = 0; k < 3; k++) {
+      if (d.truthHead) curve(d.truthHead, k, 1, 0.45);
+      curve(d.head!, k, 1.5, 1);
+    }
+    ctx.fillStyle = COLOURS.text;
+    ctx.textAlign = 'left';
+    ctx.fillText(`head ±${max.toFixed(1)}°: pitch, yaw, roll`, 4 * dpr, top + 7 * dpr);
   }
 
   private label(ctx: CanvasRenderingContext2D, phone: string, x: number, y: number): void {

@@ -15,6 +15,7 @@ import type { ExecutionProvider } from '../encoders/onnx-model';
 import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
+import { HeadMotion, headMotionParams } from '../pose/head-motion';
 import { detectWebGPU } from '../gpu/capabilities';
 import type { FaceTemplate } from '../template/face-template';
 import { DecoderBackends, type Backend } from './backends';
@@ -41,6 +42,11 @@ export interface EngineOptions extends ArtefactOptions {
   cpuWorkers?: number;
   /** Execution providers for the ONNX encoders, in order of preference (default: webgpu then wasm on a hardware adapter, else wasm). */
   onnxProviders?: ExecutionProvider[];
+  /**
+   * The head's own motion (docs/engine.md): the seed it is drawn with (default 0), or null for the pose head's mean
+   * pose alone (a head that barely moves). Ignored for a model exported without it.
+   */
+  headMotionSeed?: number | null;
 }
 
 export interface AnimateOptions {
@@ -69,13 +75,17 @@ export class TalkingFaceEngine {
     const support = await detectWebGPU();
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
-    const weights = decoderWeights(parseSafetensors(files.decoder_weights).tensors, m, manifest.model.layer_norm_eps);
+    const tensors = parseSafetensors(files.decoder_weights).tensors;
+    const weights = decoderWeights(tensors, m, manifest.model.layer_norm_eps);
+    const head = headMotionParams(tensors, m);
     const [content, pose, decoders] = await Promise.all([
       ContentEncoder.create(manifest, files, providers),
       PoseEncoder.create(manifest, files, providers),
       DecoderBackends.create(weights, template.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options),
     ]);
-    return new TalkingFaceEngine(new Pipeline(manifest, template, content, pose, decoders));
+    const pipeline = new Pipeline(manifest, template, content, pose, decoders, head && new HeadMotion(head, m.d_model));
+    if (options.headMotionSeed !== undefined) pipeline.headSeed = options.headMotionSeed;
+    return new TalkingFaceEngine(pipeline);
   }
 
   get manifest(): Manifest {
@@ -113,6 +123,22 @@ export class TalkingFaceEngine {
   /** The CPU decoder's arithmetic: 'wasm-simd' (WebAssembly SIMD) or 'js' (TypeScript, where SIMD is missing). */
   get cpuKernel(): string {
     return this.pipeline.decoders.cpuKernel;
+  }
+
+  /** Whether the model has the head's own motion (a model exported before it has only the mean pose). */
+  get hasHeadMotion(): boolean {
+    return this.pipeline.headMotion !== null;
+  }
+
+  /** The seed the head's own motion is drawn with for new animations and streams; null: the mean pose alone. */
+  get headMotionSeed(): number | null {
+    return this.pipeline.headSeed;
+  }
+
+  set headMotionSeed(seed: number | null) {
+    if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
+    this.pipeline.headSeed = seed;
+    this.rest = null;
   }
 
   /** Template units per mm (the model works in mm; poses carry mm translations). */

@@ -11,19 +11,22 @@ import type { ContentEncoder } from '../encoders/content';
 import type { PoseEncoder, PoseState } from '../encoders/pose';
 import type { DecoderBackends } from './backends';
 import { poseFrames } from '../pose/posing';
+import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
 import type { Frames, StageTimes } from './frames';
 
 /** Frames per chunk when the caller does not say: bounds memory and the WebGPU decoder's buffers. */
 export const DEFAULT_CHUNK_FRAMES = 96;
 
-/** What carries from one chunk to the next (the pose encoder's LSTM state and features). */
-export type ProducerState = PoseState;
+/** What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last residuals. */
+export type ProducerState = PoseState & { head?: HeadMotionState };
 
 export class Pipeline {
   readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
   readonly mmPerUnit: number;
   readonly templateMm: Float32Array;
+  /** The seed of the head's own motion (new states draw with it); null: the pose head's mean pose alone. */
+  headSeed: number | null = 0;
 
   constructor(
     readonly manifest: Manifest,
@@ -31,6 +34,8 @@ export class Pipeline {
     readonly content: ContentEncoder,
     readonly pose: PoseEncoder,
     readonly decoders: DecoderBackends,
+    /** The head's own motion added to the mean pose, or null for a model exported without it. */
+    readonly headMotion: HeadMotion | null,
   ) {
     this.mmPerUnit = MM_PER_UNIT[template.units];
     this.templateMm = Float32Array.from(template.positions, (v) => v * this.mmPerUnit);
@@ -111,6 +116,11 @@ export class Pipeline {
     this.times.decoder += performance.now() - t;
 
     t = performance.now();
+    if (this.headMotion && this.headSeed !== null) {
+      state.head ??= this.headMotion.start(this.headSeed);
+      const residual = this.headMotion.residuals(state.head, f0, poseToken, melIndex.length);
+      this.headMotion.compose(decoded.pose, residual, melIndex.length);
+    }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
     return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };

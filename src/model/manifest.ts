@@ -50,6 +50,8 @@ export interface Manifest {
   /** Mel frames each encoder output reads after its own position (look-ahead) and before it (context). */
   receptive_field: { content_mel_frames: number; pose_mel_frames: number; content_mel_frames_back: number; pose_mel_frames_back: number };
   look_ahead_ms: number;
+  /** The head's own motion (tensors head_motion.* in the decoder weights), or null for a model exported without it. */
+  head_motion?: { tensors: string; default_seed: number; process: string } | null;
   /** The content encoder's classes in logit order (ARPAbet phones, SIL, <blank>). */
   content_phones: string[];
 }

@@ -30,6 +30,7 @@ import torch.nn as nn
 
 from .fixtures import fixture_audio, write_fixtures
 from .model.gava import TalkingFace
+from .model.head_motion import HeadMotion
 from .paths import MODELS_DIR
 from .phones import CONTENT_CLASSES
 from .safetensors import sha256, write_safetensors
@@ -166,11 +167,14 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
           {"mel": {1: "K"}, "mel_index": {1: "T"}, "vertices": {1: "T"}, "offsets": {1: "T"}, "pose": {1: "T"}})
     files["dense_model"] = "gava_dense.onnx"
     weights = decoder_tensors(model)
+    head = HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck else None
+    if head is not None:  # the head's own motion: read by src/pose/head-motion.ts from the same file
+        weights |= {f"head_motion.{k}": np.asarray(v, np.float32) for k, v in head.to_dict().items()}
     write_safetensors(out / "gava.safetensors", weights)
     files["decoder_weights"] = "gava.safetensors"
 
     template_mm = (template.vertices * mm_per_unit).astype(np.float32)
-    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures")
+    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head)
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}
         torch.save(slim, out / "checkpoint.pt")
@@ -191,6 +195,9 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
                      "model_units": "mm (positions are multiplied by the template's mm per unit before the model)"},
         "tokens": {"count": "N + 1", "pose_token_index": template.num_vertices, "d_model": cfg.d_model, "heads": cfg.heads, "layers": cfg.layers,
                    "mask": "vertex j attends to itself and its 1-ring (template adjacency); the pose token attends to all; no vertex attends to the pose token"},
+        "head_motion": ({"tensors": "head_motion.* in gava.safetensors", "default_seed": 0,
+                         "process": "r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
+                        if head is not None else None),
         "heads": {"displacement": "Linear(d, 3), mm", "pose": f"Linear(d, 6): rotation = {cfg.max_rotation} tanh(x[0:3]) (axis-angle, rad), translation = {cfg.max_translation_mm} tanh(x[3:6]) mm; y = R (I + O) + t"},
         "files": all_files,
         "runtime_files": runtime,

@@ -20,8 +20,9 @@ FIXTURE_TOKEN_FRAMES = 2  # frames whose tokens and per-layer outputs are kept
 
 
 @torch.no_grad()
-def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path) -> dict:
-    """Every intermediate tensor of one short clip, from the same code paths the browser mirrors."""
+def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path, head_motion=None) -> dict:
+    """Every intermediate tensor of one short clip, from the same code paths the browser mirrors; with the head's
+    own motion (model/head_motion.py) when given: its residuals for seed 0, and the poses and vertices with it."""
     a = model.audio
     mel = log_mel(audio, a)                                                    # (K, n_mels)
     n_frames = int(round(len(audio) / a.sample_rate * a.fps))
@@ -50,6 +51,12 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
         "pose_features": pose_feat[0].numpy(), "pose_token": pose_token.numpy(), "template_mm": template_mm.astype(np.float32),
         "offsets": offsets.numpy(), "pose": pose.numpy(), "vertices": vertices.numpy(),
     }
+    if head_motion is not None:
+        from .model.head_motion import compose
+        residual = head_motion.sample(pose_token.numpy(), seed=0)
+        sampled = compose(pose.numpy(), residual, head_motion.pivot_mm)
+        tensors |= {"head_residual": residual.astype(np.float32), "pose_sampled": sampled,
+                    "vertices_sampled": apply_pose(torch.from_numpy(template_mm)[None] + offsets, torch.from_numpy(sampled)).numpy()}
     for i, l in enumerate(layers):
         tensors[f"layer{i}"] = l
     tensors.update(attention)

@@ -20,6 +20,7 @@ from ..data.datasets import open_dataset
 from ..features import frame_to_mel_index, log_mel
 from ..geometry.contours import lip_gap
 from ..geometry.pose import apply_pose as apply_pose_np
+from ..model import head_motion as hmodel
 from . import articulation as art
 from . import head_motion as hm
 from .data import prepare
@@ -27,7 +28,9 @@ from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
 
 
-def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None) -> dict:
+def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0) -> dict:
+    """The paper's metrics and the articulation and head-motion measures on `split`. `head`: the head's own motion
+    (model/head_motion.py), drawn with `seed` and added to the predicted pose as the browser does; None: the mean pose."""
     model.eval()
     t = ds.template
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
@@ -40,9 +43,13 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         c = prepare(ds, key, model.audio)
         mel = torch.from_numpy(c.mel)
         out = model.animate(mel, torch.from_numpy(c.template), c.num_frames)
-        pred_unposed, pred_pose = out["unposed"].numpy(), out["pose"].numpy()
+        pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
+        if head is not None:
+            feats, _ = hmodel.clip_features(model, c.mel, c.num_frames)
+            pred_pose = hmodel.compose(pred_pose, head.sample(feats, seed), head.pivot_mm)
+            pred_posed = apply_pose_np(pred_unposed, pred_pose)
         gt_posed = apply_pose_np(c.vertices, c.pose)
-        m = clip_metrics(c.vertices, pred_unposed, gt_posed, out["vertices"].numpy(), c.template, c.pose, pred_pose, regions)
+        m = clip_metrics(c.vertices, pred_unposed, gt_posed, pred_posed, c.template, c.pose, pred_pose, regions)
         m.update(key=key, source=c.source, frames=c.num_frames)
         per_clip.append(m)
         a = art.clip_articulation(art.inner_lip_gap(c.vertices, t), art.inner_lip_gap(pred_unposed, t), c.segments, ds.fps)
@@ -100,14 +107,18 @@ def main(argv=None) -> int:
     ap.add_argument("--checkpoint", required=True)
     ap.add_argument("--split", default="test")
     ap.add_argument("--out", help="write the results JSON here")
+    ap.add_argument("--head-seed", type=int, default=0, help="seed of the head's own motion, as the browser's default (when the checkpoint has one)")
+    ap.add_argument("--mean-pose", action="store_true", help="measure the pose head's mean pose alone, without the head's own motion")
     args = ap.parse_args(argv)
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
     t0 = time.time()
     heads: list = []
-    res = evaluate(model, ds, args.split, head_rows=heads)
+    head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
+    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed)
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
+    res["head_motion"]["sampled"] = {"seed": args.head_seed} if head is not None else None
     res["eval_seconds"] = time.time() - t0
     a = res["all"]
     print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
