@@ -100,10 +100,44 @@ export function avatarScene(template: FaceTemplate, basis: ArkitBasis, options: 
   mesh.updateMorphTargets(); // names -> morphTargetDictionary, which the exporter writes as extras.targetNames
   const head = new THREE.Bone();
   head.name = 'Head';
-  head.add(mesh);
+  head.add(mesh, ...eyesAndMouth(template, basis.neutral, toMetres));
   const scene = new THREE.Scene();
   scene.add(head);
   return { scene, mesh, head };
+}
+
+/**
+ * What the template mask lacks behind its openings (as the face view draws them, render/face-view.ts): an eyeball
+ * behind each lid opening, sized from it, and a dark backing behind the lips. They turn with the head.
+ */
+function eyesAndMouth(template: FaceTemplate, neutral: Float32Array, scale: number): THREE.Mesh[] {
+  const r = template.regions;
+  const box = (idx: ArrayLike<number>) => {
+    const b = new THREE.Box3();
+    for (let i = 0; i < idx.length; i++) b.expandByPoint(new THREE.Vector3().fromArray(neutral, 3 * idx[i]).multiplyScalar(scale));
+    return { center: b.getCenter(new THREE.Vector3()), size: b.getSize(new THREE.Vector3()), min: b.min, max: b.max };
+  };
+  const out: THREE.Mesh[] = [];
+  for (const side of ['left', 'right'] as const) {
+    const lids = box([...r[`eye_${side}_upper`], ...r[`eye_${side}_lower`]]);
+    const radius = lids.size.x * 0.62;
+    const eye = new THREE.Mesh(new THREE.SphereGeometry(radius, 16, 12), new THREE.MeshStandardMaterial({ color: 0xf4f1ec, roughness: 0.25 }));
+    eye.name = `eye_${side}`;
+    eye.position.set(lids.center.x, lids.center.y, lids.max.z - radius - lids.size.z * 0.15);
+    const iris = new THREE.Mesh(new THREE.CircleGeometry(radius * 0.34, 16), new THREE.MeshStandardMaterial({ color: 0x3b2a1e, roughness: 0.3 }));
+    iris.name = `iris_${side}`;
+    iris.position.z = radius * 1.001;
+    eye.add(iris);
+    out.push(eye);
+  }
+  const inner = box([...r.lips_inner_upper, ...r.lips_inner_lower]);
+  const outer = box(r.lips_outer);
+  const mouth = new THREE.Mesh(new THREE.SphereGeometry(1, 16, 12), new THREE.MeshStandardMaterial({ color: 0x2a0a0c, roughness: 0.9 }));
+  mouth.name = 'mouth_backing';
+  mouth.scale.set(inner.size.x * 0.48, outer.size.y * 0.9, inner.size.x * 0.4);
+  mouth.position.set(inner.center.x, inner.center.y - outer.size.y * 0.15, outer.min.z - inner.size.x * 0.18);
+  out.push(mouth);
+  return out;
 }
 
 /** A test avatar as .glb bytes: the template with ARKit (or viseme) morph targets under a "Head" node. */

@@ -11,6 +11,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import { GltfAvatar } from './gltf-avatar';
+import { Blinks } from './blinks';
 
 export class AvatarView {
   readonly renderer: THREE.WebGLRenderer;
@@ -20,6 +21,8 @@ export class AvatarView {
   private readonly resizeObserver: ResizeObserver;
   private needsRender = true;
   private frameHandle = 0;
+  private readonly blinks = new Blinks(performance.now());
+  private blink = 0;
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
@@ -103,6 +106,12 @@ export class AvatarView {
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
     if (this.controls.update()) this.needsRender = true;
+    const blink = this.avatar.canBlink ? this.blinks.at(performance.now()) : 0;
+    if (blink !== this.blink) {
+      this.blink = blink;
+      this.avatar.setIdleBlink(blink);
+      this.needsRender = true;
+    }
     if (!this.needsRender) return;
     this.needsRender = false;
     this.renderer.render(this.scene, this.camera);

@@ -12,10 +12,16 @@ import type { FaceTemplate } from '../template/face-template';
 import { ARKIT_NAMES, type ArkitName } from './names';
 import { faceFields, interp, type EyeFields, type FaceFields } from './fields';
 
-/** jawOpen = 1 turns the mandible this far about the rig's hinge (the rig's jaw = 1 is 8 degrees: AA is 0.95 of it). */
-export const JAW_OPEN_DEGREES = 20;
+/**
+ * jawOpen = 1 turns the mandible this far about the rig's hinge: a wide speaking opening (the rig's jaw = 1 is 8
+ * degrees, its AA 0.95 of that), so speech lands at ARKit-like jawOpen values (0.2 to 0.6).
+ */
+export const JAW_OPEN_DEGREES = 12;
 /** The rotation is linearised at a speech-sized opening, where the model's frames lie, not at jawOpen = 1. */
 const JAW_LINEARISED_AT_DEGREES = 4;
+
+/** mouthUpperUp and mouthLowerDown at 1 move the middle of the upper (lower) lip this far (fractions of W). */
+const LIP_PART = { upper: 0.15, lower: 0.2 };
 
 /** mouthPucker and mouthFunnel: how much of the lips' half-width they take in, and how far forward (in W) they push. */
 export const PUCKER = { narrow: 0.28, forward: 0.07 };
@@ -36,6 +42,8 @@ export interface ArkitBasis {
   shapes: Float32Array;
   /** Per shape: whether the solver fits it (gaze and the tongue are not in the mesh; they stay 0). */
   fitted: boolean[];
+  /** Per shape: whether it is one of the rig's articulators (speech), not an expression the rig never makes. */
+  speech: boolean[];
   regions: ShapeRegion[];
   /** Inner mouth width (mm). */
   mouthWidth: number;
@@ -44,6 +52,11 @@ export interface ArkitBasis {
 /** Not fitted: the template has no eyeballs and no tongue, and the corpus moves neither (docs/avatar.md). */
 const NOT_FITTED = new Set<ArkitName>(['eyeLookDownLeft', 'eyeLookInLeft', 'eyeLookOutLeft', 'eyeLookUpLeft',
   'eyeLookDownRight', 'eyeLookInRight', 'eyeLookOutRight', 'eyeLookUpRight', 'tongueOut']);
+
+/** The shapes that span the rig's articulators (jaw, lip opening, rounding, protrusion, spreading, closure, the lower lip to the teeth, blinks, brows). */
+const SPEECH = new Set<ArkitName>(['jawOpen', 'mouthClose', 'mouthFunnel', 'mouthPucker', 'mouthSmileLeft', 'mouthSmileRight',
+  'mouthStretchLeft', 'mouthStretchRight', 'mouthRollLower', 'mouthLowerDownLeft', 'mouthLowerDownRight', 'mouthUpperUpLeft',
+  'mouthUpperUpRight', 'eyeBlinkLeft', 'eyeBlinkRight', 'browInnerUp', 'browOuterUpLeft', 'browOuterUpRight', 'browDownLeft', 'browDownRight']);
 
 type Vec = [number, number, number];
 
@@ -67,6 +80,7 @@ export function arkitBasis(template: FaceTemplate): ArkitBasis {
     neutralOffset: Float32Array.from(neutral, (x, i) => x - f.rest[i]),
     shapes,
     fitted: ARKIT_NAMES.map((name) => !NOT_FITTED.has(name)),
+    speech: ARKIT_NAMES.map((name) => SPEECH.has(name)),
     regions,
     mouthWidth: W,
   };
@@ -149,13 +163,33 @@ function definitions(f: FaceFields, neutral: Float64Array): Record<ArkitName, { 
   const cheekPuffL = cheek(1), cheekPuffR = cheek(-1);
 
   const shape = (s: Float64Array, region: ShapeRegion) => ({ shape: s, region });
-  const [smileL, smileR] = sides((s) => field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.06 * W, 0.07 * W, -0.03 * W]));
-  const [frownL, frownR] = sides((s) => field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.01 * W, -0.07 * W, 0]));
-  const [dimpleL, dimpleR] = sides((s) => field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.03 * W, 0, -0.06 * W]));
-  const [stretchL, stretchR] = sides((s) => field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.1 * W, -0.03 * W, -0.03 * W]));
+  // The corner shapes share the corners' field and differ in direction, and each also moves its own neighbourhood,
+  // so no one of them is a mix of the others: smiling lifts the cheek above the corner, frowning pulls the skin below
+  // it down, stretching draws the lower lip down with it, a dimple is the corner alone (its field squared).
+  const nearCorner = (side: number, up: number) => bump([c[0] + side * 0.55 * W, f.cornerY + up * W], 0.3 * W);
+  const aboveL = nearCorner(1, 0.2), aboveR = nearCorner(-1, 0.2), belowL = nearCorner(1, -0.25), belowR = nearCorner(-1, -0.25);
+  const [smileL, smileR] = sides((s) => add(field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.06 * W, 0.07 * W, -0.03 * W]),
+    field((i) => (aboveL(i) + aboveR(i)) * s(i), k(0, 0.03, 0.01))));
+  const [frownL, frownR] = sides((s) => add(field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.01 * W, -0.07 * W, 0]),
+    field((i) => (belowL(i) + belowR(i)) * s(i), k(0, -0.03, 0))));
+  const [dimpleL, dimpleR] = sides((s) => field((i) => cornerW(i) ** 2 * s(i), (i) => [sgn(i) * 0.05 * W, 0, -0.12 * W]));
+  const [stretchL, stretchR] = sides((s) => add(field((i) => cornerW(i) * s(i), (i) => [sgn(i) * 0.1 * W, -0.03 * W, -0.03 * W]),
+    field((i) => f.wLower[i] * s(i), k(0, -0.02, 0))));
   const [pressL, pressR] = sides((s) => field((i) => s(i), (i) => [0, 0.02 * W * (f.wLower[i] - f.wUpper[i]), -0.015 * W * f.wLips[i]]));
-  const [lowerDownL, lowerDownR] = sides((s) => field((i) => f.wLower[i] * s(i), k(0, -0.12, 0.01)));
-  const [upperUpL, upperUpR] = sides((s) => field((i) => f.wUpper[i] * s(i), k(0, 0.12, 0.01)));
+  // Each lip parting from the closed neutral: half the closure undone (most at the middle, none at the corners,
+  // the depths parting too), half the rig's lip opening (the whole lip alike); the middle of the lip moves LIP_PART * W.
+  const none = new Float64Array(n);
+  const parting = (upper: boolean, size: number) => {
+    const d = closure(f.rest, f.upperLip, f.lowerLip, upper ? f.wUpper : none, upper ? none : f.wLower, 0.5);
+    const w = upper ? f.wUpper : f.wLower;
+    let most = 0;
+    for (let i = 0; i < n; i++) most = Math.max(most, Math.abs(d[3 * i + 1]));
+    const sign = upper ? 1 : -1;
+    return (i: number): Vec => [0, size * W * (0.5 * sign * Math.abs(d[3 * i + 1]) / most + 0.5 * sign * w[i]), (-0.5 * size * W * d[3 * i + 2]) / most];
+  };
+  const upperParting = parting(true, LIP_PART.upper), lowerParting = parting(false, LIP_PART.lower);
+  const [lowerDownL, lowerDownR] = sides((s) => field(s, lowerParting));
+  const [upperUpL, upperUpR] = sides((s) => field(s, upperParting));
   return {
     eyeBlinkLeft: shape(L.blink, 'eye_left'), eyeLookDownLeft: shape(L.lookDown, 'eye_left'),
     eyeLookInLeft: shape(L.lookIn, 'eye_left'), eyeLookOutLeft: shape(L.lookOut, 'eye_left'),
@@ -168,9 +202,8 @@ function definitions(f: FaceFields, neutral: Float64Array): Record<ArkitName, { 
     jawRight: shape(field((i) => f.wJaw[i], k(-0.1, 0, 0)), 'jaw'),
     jawOpen: shape(jawOpen, 'jaw'),
     mouthClose: shape(mouthClose, 'mouth'),
-    // The rig's protrusion with the lips flared apart, and its rounding with a little protrusion.
-    mouthFunnel: shape(add(field((i) => f.wLips[i], (i) => [-FUNNEL.narrow * dx(i), 0, FUNNEL.forward * W]),
-      field(() => 1, (i) => [0, 0.03 * W * (f.wUpper[i] ** 2 - f.wLower[i] ** 2), 0])), 'mouth'),
+    // The rig's protrusion (with a little narrowing), and its rounding with a little protrusion.
+    mouthFunnel: shape(field((i) => f.wLips[i], (i) => [-FUNNEL.narrow * dx(i), 0, FUNNEL.forward * W]), 'mouth'),
     mouthPucker: shape(field((i) => f.wLips[i], (i) => [-PUCKER.narrow * dx(i), 0, PUCKER.forward * W]), 'mouth'),
     mouthLeft: shape(field((i) => f.wLips[i], k(0.1, 0, 0)), 'mouth'),
     mouthRight: shape(field((i) => f.wLips[i], k(-0.1, 0, 0)), 'mouth'),

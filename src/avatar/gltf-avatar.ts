@@ -5,7 +5,7 @@
  */
 import * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
+import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
 
 export class AvatarLoadError extends Error {
   override name = 'AvatarLoadError';
@@ -32,12 +32,18 @@ export class GltfAvatar {
   private readonly parentWorld = new THREE.Quaternion();
   private readonly parentInverse = new THREE.Quaternion();
 
+  /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
+  private readonly modelBlink = [0, 0];
+  private idleBlink = 0;
+
   private constructor(
     readonly gltf: GLTF,
     readonly scheme: 'arkit' | 'visemes',
     private readonly targets: Target[],
     readonly matched: string[],
     readonly head: THREE.Object3D | null,
+    /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
+    private readonly blinkTargets: Target[],
   ) {
     if (head) {
       gltf.scene.updateMatrixWorld(true);
@@ -56,12 +62,13 @@ export class GltfAvatar {
     const magic = String.fromCharCode(...head);
     const firstChar = String.fromCharCode(...new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength))).trimStart()[0];
     if (magic !== 'glTF' && firstChar !== '{') {
-      throw new AvatarLoadError(`${source} is not a glTF file (a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}): export the avatar as .glb`);
+      const what = firstChar === '<' ? 'it is an HTML page: is the URL right?' : `a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}`;
+      throw new AvatarLoadError(`${source} is not a glTF file (${what}): export the avatar as .glb`);
     }
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
     let gltf: GLTF;
     try {
-      gltf = await new GLTFLoader().parseAsync(bytes, new URL('.', new URL(source, globalThis.location?.href ?? 'file:///')).href);
+      gltf = await new GLTFLoader().parseAsync(bytes, folderOf(source));
     } catch (e) {
       throw new AvatarLoadError(`${source} could not be read as glTF: ${(e as Error).message}`);
     }
@@ -92,23 +99,45 @@ export class GltfAvatar {
     const targets = scheme === 'arkit' ? arkit : visemes;
     const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
     const matched = [...new Set(targets.map((t) => all[t.channel]))];
-    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone));
+    const blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
+      .map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
+    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone), blinks);
   }
 
   get summary(): AvatarSummary {
     return { scheme: this.scheme, matched: this.matched, headBone: this.head?.name ?? null };
   }
 
+  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets). */
+  get canBlink(): boolean {
+    return this.blinkTargets.length > 0;
+  }
+
   /** Set the morph targets from one frame of output: ARKit weights (52) and visemes (15), each from its index `at`. */
   setWeights(arkit: ArrayLike<number>, arkitAt: number, visemes: ArrayLike<number>, visemesAt: number): void {
     const [values, at] = this.scheme === 'arkit' ? [arkit, arkitAt] : [visemes, visemesAt];
     for (const t of this.targets) t.influences[t.at] = values[at + t.channel];
+    this.modelBlink[0] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkLeft];
+    this.modelBlink[1] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkRight];
+    this.applyBlink();
+  }
+
+  /** An idle blink's lid closure (blinks.ts) on top of the model's own eyeBlink weights. */
+  setIdleBlink(amount: number): void {
+    this.idleBlink = amount;
+    this.applyBlink();
   }
 
   /** Every driven morph target back to 0 and the head to its rest pose. */
   reset(): void {
     for (const t of this.targets) t.influences[t.at] = 0;
+    this.modelBlink.fill(0);
+    this.applyBlink();
     this.head?.quaternion.copy(this.rest);
+  }
+
+  private applyBlink(): void {
+    for (const t of this.blinkTargets) t.influences[t.at] = Math.max(this.modelBlink[t.channel], this.idleBlink);
   }
 
   /**
@@ -126,6 +155,16 @@ export class GltfAvatar {
   }
 }
 
+/** The folder a .gltf's external files are read from ('' for a blob: or data: URL, which has none). */
+function folderOf(source: string): string {
+  try {
+    const url = new URL(source, globalThis.location?.href ?? 'file:///');
+    return url.protocol === 'blob:' || url.protocol === 'data:' ? '' : new URL('.', url).href;
+  } catch {
+    return ''; // deliberate: a name that is no URL has no folder; an embedded .glb needs none
+  }
+}
+
 const scratch = new THREE.Quaternion();
 const axis = new THREE.Vector3();
 
@@ -137,8 +176,9 @@ function findHead(scene: THREE.Object3D, source: string, name?: string | null): 
     const found = nodes.find((o) => o.name === name);
     if (!found) {
       const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
+      const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);
       throw new AvatarLoadError(`${source} has no node named "${name}" (avatar-head-bone); ` +
-        (bones.length ? `its bones are: ${bones.slice(0, 60).join(', ')}` : 'it has no bones'));
+        `its ${bones.length ? 'bones' : 'nodes'} are: ${named.slice(0, 60).join(', ')}`);
     }
     return found;
   }

@@ -2,13 +2,14 @@
  * From the model's per-frame displacement O (unposed minus template, mm) to ARKit weights in [0, 1]: bounded
  * least squares on the basis (basis.ts),
  *
- *   min_w || B w - (O - neutralOffset) ||^2 + lambda || w ||^2,   0 <= w <= 1,
+ *   min_w || B w - (O - neutralOffset) ||^2 + lambda || w ||^2 + sum_k mu_k w_k,   0 <= w <= 1,
  *
  * solved exactly by a primal active-set method on the normal equations (the Gram matrix B^T B is computed once;
  * each step solves the free weights by Cholesky), started from the previous frame's weights and bounds:
  * consecutive frames differ little, so most frames need one or two solves. The small ridge term makes the
  * minimiser unique (some shapes overlap, e.g. mouthLeft and jawLeft near the chin), so the answer does not
- * depend on the start: chunked, streamed and whole-clip solves agree.
+ * depend on the start: chunked, streamed and whole-clip solves agree. The L1 term (mu_k; on w >= 0 it is linear)
+ * keeps the weights sparse: the motion goes to the shapes that explain it, the rig's articulators first.
  */
 import { ARKIT_NAMES } from './names';
 import type { ArkitBasis } from './basis';
@@ -16,6 +17,12 @@ import type { ArkitBasis } from './basis';
 export interface SolverOptions {
   /** The ridge term, as a fraction of the mean squared norm of the shapes (default 1e-3). */
   ridge?: number;
+  /**
+   * The L1 term on the speech shapes (the rig's articulators: basis.speech) and on the others, as fractions of each
+   * shape's squared norm (default 0.002 and 0.02): a shape is used only where it explains more than that, so the
+   * motion is not spread over expressions that cancel each other (mouthFrown against mouthUpperUp, say).
+   */
+  sparsity?: { speech: number; other: number };
 }
 
 /** What carries from one frame to the next: the last weights (the warm start). */
@@ -31,6 +38,7 @@ export class BlendshapeSolver {
   private readonly rows: Float32Array; // (A x 3N) the fitted shapes, one per row
   private readonly gram: Float64Array; // (A x A) B^T B + lambda I
   private readonly scale: number;
+  private readonly l1: Float64Array; // per fitted shape: the L1 weight (w >= 0, so a linear term)
   private readonly h: Float64Array;
   private readonly w: Float64Array;
   private readonly z: Float64Array;
@@ -55,6 +63,8 @@ export class BlendshapeSolver {
     let trace = 0;
     for (let a = 0; a < A; a++) trace += this.gram[a * A + a];
     this.scale = trace / A;
+    const sparsity = options.sparsity ?? { speech: 0.002, other: 0.02 };
+    this.l1 = Float64Array.from(this.active, (k, a) => (basis.speech[k] ? sparsity.speech : sparsity.other) * this.gram[a * A + a]);
     for (let a = 0; a < A; a++) this.gram[a * A + a] += (options.ridge ?? 1e-3) * this.scale;
     [this.h, this.w, this.z, this.rhs] = [0, 0, 0, 0].map(() => new Float64Array(A));
     this.bound = new Int8Array(A);
@@ -78,7 +88,7 @@ export class BlendshapeSolver {
       let s = 0;
       const r = a * n3;
       for (let i = 0; i < n3; i++) s += rows[r + i] * (offsets[at + i] - neutral[i]);
-      h[a] = s;
+      h[a] = s - this.l1[a];
       w[a] = Math.min(1, Math.max(0, state.weights[active[a]]));
       bound[a] = w[a] <= 0 ? -1 : w[a] >= 1 ? 1 : 0;
     }
@@ -101,19 +111,22 @@ export class BlendshapeSolver {
         w[blocking] = bound[blocking] < 0 ? 0 : 1;
         continue;
       }
-      // Optimal over the free set: release the held weight whose gradient most wants it back inside.
-      let worst = eps, release = -1;
+      // Optimal over the free set: release every held weight whose gradient wants it back inside (the next step
+      // holds again any that the joint solve pushes out, so the cost still falls at every step).
+      let released = 0;
       for (let a = 0; a < A; a++) {
         if (bound[a] === 0) continue;
         let g = -h[a];
         for (let b = 0; b < A; b++) g += gram[a * A + b] * w[b];
-        const pull = bound[a] < 0 ? -g : g; // > 0: moving inside lowers the cost
-        if (pull > worst) [worst, release] = [pull, a];
+        if ((bound[a] < 0 ? -g : g) > eps) { // moving inside lowers the cost
+          bound[a] = 0;
+          released++;
+        }
       }
-      if (release < 0) break;
-      bound[release] = 0;
+      if (!released) break;
     }
     this.lastSolves = solves;
+    state.weights.fill(0); // the shapes not fitted stay 0
     for (let a = 0; a < A; a++) state.weights[active[a]] = w[a];
     out.set(state.weights, outAt);
   }

@@ -13,6 +13,7 @@
  */
 import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
+import type { GltfAvatar } from '../avatar/gltf-avatar';
 import { frameWeights } from '../avatar/weights';
 import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
@@ -93,9 +94,14 @@ export class TalkingFaceElement extends HTMLElement {
     return this.engine?.backend ?? null;
   }
 
-  /** The last offline animation (posed vertices per frame), e.g. to export it. */
+  /** The last offline animation (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it. */
   get currentAnimation(): Animation | null {
     return this.animation;
+  }
+
+  /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
+  get avatar(): GltfAvatar | null {
+    return this.view instanceof AvatarView ? this.view.avatar : null;
   }
 
   connectedCallback(): void {
@@ -283,7 +289,7 @@ export class TalkingFaceElement extends HTMLElement {
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
       detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
-        avatar: this.view instanceof AvatarView ? this.view.avatar.summary : undefined },
+        avatar: this.avatar?.summary },
     }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
