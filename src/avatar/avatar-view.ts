@@ -13,6 +13,9 @@ import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import { GltfAvatar } from './gltf-avatar';
 import { Blinks } from './blinks';
 
+/** About a head's bounding radius in metres (glTF's unit). */
+const HEAD_RADIUS = 0.15;
+
 export class AvatarView {
   readonly renderer: THREE.WebGLRenderer;
   readonly scene = new THREE.Scene();
@@ -42,6 +45,11 @@ export class AvatarView {
     });
     if (box.isEmpty()) box.setFromObject(avatar.gltf.scene);
     const sphere = box.getBoundingSphere(new THREE.Sphere());
+    if (avatar.head && sphere.radius > HEAD_RADIUS * 3) {
+      // One mesh for the whole body: frame the head (glTF is in metres), just above its bone.
+      avatar.head.getWorldPosition(sphere.center).y += HEAD_RADIUS / 2;
+      sphere.radius = HEAD_RADIUS;
+    }
     this.camera = new THREE.PerspectiveCamera(30, 1, sphere.radius / 20, sphere.radius * 40);
     this.camera.position.set(sphere.center.x, sphere.center.y, sphere.center.z + sphere.radius * 3.6);
     this.controls = new OrbitControls(this.camera, canvas);

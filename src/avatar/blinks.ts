@@ -17,7 +17,8 @@ export class Blinks {
   /** Lid closure in [0, 1] at time `now` (ms, increasing). */
   at(now: number): number {
     if (!this.blink && now >= this.next) {
-      this.blink = { start: now, duration: 100 + 50 * this.random(), amount: this.random() > 0.2 ? 1 : 0.5 + 0.35 * this.random() };
+      const seconds = 0.1 + 0.05 * this.random(); // as sample_blinks: uniform(0.1, 0.15)
+      this.blink = { start: now, duration: 1000 * seconds, amount: this.random() > 0.2 ? 1 : 0.5 + 0.35 * this.random() };
       this.next = now + this.interval();
     }
     const b = this.blink;

@@ -4,12 +4,10 @@
  *   <script type="module" src="/lib/talking-face.js"></script>
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
- * Attributes: model (manifest URL), template (template URL; must be the model's template), src (audio
- * URL to speak), backend (auto | cpu | webgpu), autoplay (speak src as soon as it is animated), live
- * (animate the microphone), avatar (a glTF avatar to drive instead of the face; src/avatar/), avatar-head-bone,
- * blendshapes (frame events carry ARKit weights and visemes without an avatar). Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame,
- * ended, error (detail.message is written for a person). Instances are independent; instances with the
- * same model and backend share one engine (its runs are serialised).
+ * Attributes: model, template, src, backend (auto | cpu | webgpu), autoplay, live, avatar (a glTF avatar driven
+ * instead of the face, src/avatar/), avatar-head-bone, blendshapes. Methods: speak(audio), startMicrophone(),
+ * stop(). Events: ready, frame, ended, error (detail.message is written for a person). Instances are independent;
+ * instances with the same model and backend share one engine (its runs are serialised).
  */
 import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
@@ -259,7 +257,7 @@ export class TalkingFaceElement extends HTMLElement {
     return this.loading;
   }
 
-  /** Frames carry ARKit weights and visemes: with an avatar, or when the page asks (`blendshapes`). */
+  /** Frames carry ARKit weights and visemes with an avatar, or when the page asks. */
   private get blendshapes(): boolean {
     return this.hasAttribute('avatar') || this.hasAttribute('blendshapes');
   }
@@ -274,8 +272,7 @@ export class TalkingFaceElement extends HTMLElement {
         view = avatar ? await AvatarView.load(this.canvas, new URL(avatar, document.baseURI).href, this.getAttribute('avatar-head-bone'))
           : new FaceView(this.canvas, engine.template);
       } catch (e) {
-        const m = (e as Error).message;
-        this.fail(avatar ? 'avatar' : 'model', avatar ? `the avatar cannot be used: ${m}` : `the face cannot be drawn here (WebGL unavailable?): ${m}`);
+        this.fail(avatar ? 'avatar' : 'model', `${avatar ? 'the avatar cannot be used' : 'the face cannot be drawn here (WebGL unavailable?)'}: ${(e as Error).message}`);
         return;
       }
       if (token !== this.viewToken || this.view) return view.dispose(); // superseded while the avatar loaded
