@@ -3,6 +3,7 @@
  * costs per frame; writes docs/results/avatar.md and .json.
  *
  *   npm run avatar-fit [-- --corpus data/corpus --max-clips 80 --port 4195]
+ *   npm run avatar-fit -- --from-json      (rewrite the .md from the .json, nothing run)
  *
  * Clips: the corpus's test split (unseen voices, sentences and faces) when it is built, else the three sample clips
  * in models/samples. The engine runs in headless Chromium (dev/avatar-fit.html) with `blendshapes: true`; here, each
@@ -217,7 +218,10 @@ averaged over frames (as E_vl). Reproduced: 1 - error^2 / motion^2, summed over 
 ${rows.join('\n')}
 
 Regions: lips (the lip surface, as E_vl's), eyes (the lids' rig fields), brows (the brows' rig field), jaw (below
-the mouth corners), rest (nose, cheeks, forehead, outline); face: all ${r.regions.face.vertices} vertices.
+the mouth corners), rest (nose, cheeks, forehead, outline); face: all ${r.regions.face.vertices} vertices. The model
+barely moves the eyes and brows (RMS ${r.regions.eyes.rmsMotionMm} and ${r.regions.brows.rmsMotionMm} mm: no blinks, which
+audio does not predict), so the share reproduced there is a share of almost nothing; the sparse solver leaves such
+motion at 0 rather than spend eyeBlink or brow weights on it.
 ${r.truth ? `
 Against the ground truth (${r.truth.frames} frames with truth): the prediction's largest lip error per frame
 ${r.truth.predictionLipMaxMm} mm, the weights' reconstruction's ${r.truth.weightsLipMaxMm} mm (mean over all vertices
@@ -242,4 +246,6 @@ difference: ${r.streamedAgainstOffline}).
 `;
 }
 
-await main();
+if (args.includes('--from-json')) {
+  writeFileSync(resolve(ROOT, 'docs/results/avatar.md'), report(JSON.parse(readFileSync(resolve(ROOT, 'docs/results/avatar.json'), 'utf8'))));
+} else await main();
