@@ -108,17 +108,30 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
   expect(mean(open.flat().map(v(AA)))).toBeGreaterThan(0.4);
   expect(mean(closed.flat().map(v(AA)))).toBeLessThan(0.2);
 
-  // Frame events carried the weights by name, and the avatar moved: jaw, head, a blink.
+  // Frame events carried the weights by name (one per frame drawn: few on a loaded machine), equal to the take's.
   const frames = (await events('arkit')).filter((e) => e.type === 'frame');
-  expect(frames.length).toBeGreaterThan(20);
-  expect(Object.keys(frames[frames.length - 1].detail.arkit)).toEqual([...ARKIT_NAMES]);
-  expect(frames.some((e) => e.detail.arkit.jawOpen > 0.2 && e.detail.visemes.viseme_aa >= 0)).toBe(true);
-  expect(frames.every((e) => Number.isFinite(e.detail.headRotation.yaw))).toBe(true);
+  expect(frames.length).toBeGreaterThan(3);
+  for (const e of frames) {
+    expect(Object.keys(e.detail.arkit)).toEqual([...ARKIT_NAMES]);
+    expect(e.detail.arkit.jawOpen).toBeCloseTo(w('jawOpen')(e.detail.frame), 6);
+    expect(Object.keys(e.detail.visemes)).toHaveLength(15);
+    expect(Number.isFinite(e.detail.headRotation.yaw)).toBe(true);
+  }
+  // The avatar shows the last frame's weights now that playback has ended (the blinks may add to eyeBlink).
+  const shown = await page.evaluate(() => {
+    const out: Record<string, number> = {};
+    (document.getElementById('arkit') as unknown as FaceEl).avatar!.gltf.scene.traverse((o) => {
+      const m = o as { morphTargetDictionary?: Record<string, number>; morphTargetInfluences?: number[] };
+      if (m.morphTargetDictionary) for (const [name, k] of Object.entries(m.morphTargetDictionary)) out[name] = m.morphTargetInfluences![k];
+    });
+    return out;
+  });
+  for (const name of ARKIT_NAMES.filter((n) => !n.startsWith('eyeBlink'))) expect(shown[name], name).toBeCloseTo(w(name)(arkit.frames - 1), 6);
   const watched = () => page.evaluate(() => {
     const g = globalThis as unknown as { maxBlink: number; maxJaw: number; headMoved: boolean };
     return { maxBlink: g.maxBlink, maxJaw: g.maxJaw, headMoved: g.headMoved };
   });
-  expect((await watched()).maxJaw).toBeGreaterThan(0.2);
+  expect((await watched()).maxJaw).toBeGreaterThan(0.1);
   expect((await watched()).headMoved).toBe(true);
   await expect.poll(async () => (await watched()).maxBlink, { timeout: 15_000, message: 'the avatar blinks' }).toBeGreaterThan(0.5);
   for (const id of ['arkit', 'visemes']) expect((await events(id)).filter((e) => e.type === 'error')).toEqual([]);
@@ -154,7 +167,7 @@ function renamedAvatar(rename: (name: string) => string): string {
   const b = readFileSync(resolve(AVATARS, 'visemes-face.glb'));
   const jsonLength = b.readUInt32LE(12);
   const gltf = JSON.parse(b.subarray(20, 20 + jsonLength).toString());
-  for (const mesh of gltf.meshes) mesh.extras.targetNames = mesh.extras.targetNames.map(rename);
+  for (const mesh of gltf.meshes) if (mesh.extras?.targetNames) mesh.extras.targetNames = mesh.extras.targetNames.map(rename);
   let text = JSON.stringify(gltf);
   while (text.length % 4) text += ' ';
   const json = Buffer.from(text);
