@@ -4,10 +4,9 @@
  *   <script type="module" src="/lib/talking-face.js"></script>
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
- * Attributes: model, template, src, backend (auto | cpu | webgpu), autoplay, live, avatar (a glTF avatar driven
- * instead of the face, src/avatar/), avatar-head-bone, blendshapes. Methods: speak(audio), startMicrophone(),
- * stop(). Events: ready, frame, ended, error (detail.message is written for a person). Instances are independent;
- * instances with the same model and backend share one engine (its runs are serialised).
+ * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
+ * avatar-head-bone, blendshapes. Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame, ended, error
+ * (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
 import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
