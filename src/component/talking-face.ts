@@ -4,49 +4,26 @@
  *   <script type="module" src="/lib/talking-face.js"></script>
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
- * Attributes: model (manifest URL), template (template URL; must be the model's template), src (audio
- * URL to speak), backend (auto | cpu | webgpu), autoplay (speak src as soon as it is animated), live
- * (animate the microphone). Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame,
- * ended, error (detail.message is written for a person). Instances are independent; instances with the
- * same model and backend share one engine (its runs are serialised).
+ * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
+ * avatar-head-bone, blendshapes. Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame, ended, error
+ * (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
 import { FaceView } from '../render/face-view';
+import { AvatarView } from '../avatar/avatar-view';
+import type { GltfAvatar } from '../avatar/gltf-avatar';
+import { frameWeights } from '../avatar/weights';
 import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { Player, audioNotes } from '../player/player';
+import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
+
+export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
 /** The model an element loads when it has no `model` attribute. */
 export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
-
-export interface ReadyDetail {
-  backend: Backend;
-  reason: string;
-  vertices: number;
-  model: string;
-}
-
-export interface FrameDetail {
-  /** Frame index in the current take (offline) or since the microphone started (live). */
-  frame: number;
-  /** Seconds into the audio. */
-  time: number;
-  mode: 'playback' | 'live';
-  backend: Backend;
-  /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
-  inferenceMs?: number;
-  latencyMs?: number;
-  /** Offline: seconds of audio per second of compute. */
-  realTimeFactor?: number;
-}
-
-export interface TalkingFaceErrorDetail {
-  message: string;
-  /** What failed: loading the model, decoding audio, the microphone, or inference. */
-  stage: 'model' | 'audio' | 'microphone' | 'inference';
-}
 
 const engines = new Map<string, Promise<TalkingFaceEngine>>();
 
@@ -72,11 +49,11 @@ canvas:focus-visible { box-shadow: inset 0 0 0 3px #7ab8ff; }
 `;
 
 export class TalkingFaceElement extends HTMLElement {
-  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live'];
+  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
 
   private readonly canvas: HTMLCanvasElement;
   private readonly statusLine: HTMLParagraphElement;
-  private view: FaceView | null = null;
+  private view: FaceView | AvatarView | null = null;
   private player: Player | null = null;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
@@ -85,6 +62,7 @@ export class TalkingFaceElement extends HTMLElement {
   private computeMs = 0;
   private audioSeconds = 0;
   private generation = 0; // bumps on stop() and on every new speak(): stale work drops its results
+  private viewToken = {}; // the view being made (an avatar loads asynchronously)
 
   constructor() {
     super();
@@ -113,9 +91,14 @@ export class TalkingFaceElement extends HTMLElement {
     return this.engine?.backend ?? null;
   }
 
-  /** The last offline animation (posed vertices per frame), e.g. to export it. */
+  /** The last offline animation (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it. */
   get currentAnimation(): Animation | null {
     return this.animation;
+  }
+
+  /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
+  get avatar(): GltfAvatar | null {
+    return this.view instanceof AvatarView ? this.view.avatar : null;
   }
 
   connectedCallback(): void {
@@ -127,6 +110,7 @@ export class TalkingFaceElement extends HTMLElement {
 
   disconnectedCallback(): void {
     this.stop();
+    this.viewToken = {};
     this.player?.dispose();
     this.player = null;
     this.view?.dispose();
@@ -135,10 +119,11 @@ export class TalkingFaceElement extends HTMLElement {
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
     if (old === value || !this.isConnected) return;
-    if (name === 'model' || name === 'template') {
+    if (name === 'model' || name === 'template' || name.startsWith('avatar')) {
       this.stop();
       this.loading = null;
       this.engine = null;
+      this.viewToken = {};
       this.player?.dispose();
       this.player = null;
       this.view?.dispose();
@@ -190,6 +175,7 @@ export class TalkingFaceElement extends HTMLElement {
     try {
       animation = await engine.animate(decoded.samples, {
         unposed: true,
+        blendshapes: this.blendshapes,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
     } catch (e) {
@@ -228,9 +214,10 @@ export class TalkingFaceElement extends HTMLElement {
         this.player.showLive(frames);
         const latency = this.live?.stream.latency;
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
-          detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs },
+          detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs,
+            ...(frames.blendshapes && frameWeights(frames.blendshapes, last)) },
         }));
-      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`) });
+      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
       throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
@@ -269,16 +256,27 @@ export class TalkingFaceElement extends HTMLElement {
     return this.loading;
   }
 
-  private afterLoad(): void {
+  /** Frames carry ARKit weights and visemes with an avatar, or when the page asks. */
+  private get blendshapes(): boolean {
+    return this.hasAttribute('avatar') || this.hasAttribute('blendshapes');
+  }
+
+  private async afterLoad(): Promise<void> {
     const engine = this.engine!;
+    const avatar = this.getAttribute('avatar');
     if (!this.view) {
+      const token = (this.viewToken = {});
+      let view: FaceView | AvatarView;
       try {
-        this.view = new FaceView(this.canvas, engine.template);
-        this.player = new Player(this.view, engine.unitsPerMm, { onFrame: (f) => this.playbackFrame(f), onEnded: () => this.dispatchEvent(new CustomEvent('ended')) });
+        view = avatar ? await AvatarView.load(this.canvas, new URL(avatar, document.baseURI).href, this.getAttribute('avatar-head-bone'))
+          : new FaceView(this.canvas, engine.template);
       } catch (e) {
-        this.fail('model', `the face cannot be drawn here (WebGL unavailable?): ${(e as Error).message}`);
+        this.fail(avatar ? 'avatar' : 'model', `${avatar ? 'the avatar cannot be used' : 'the face cannot be drawn here (WebGL unavailable?)'}: ${(e as Error).message}`);
         return;
       }
+      if (token !== this.viewToken || this.view) return view.dispose(); // superseded while the avatar loaded
+      this.view = view;
+      this.player = new Player(view, engine.unitsPerMm, { onFrame: (f) => this.playbackFrame(f), onEnded: () => this.dispatchEvent(new CustomEvent('ended')) });
     }
     engine.restFace().then(
       (rest) => { if (!this.animation) this.view?.setVertices(rest); }, // the mouth closed at rest, not the opened template
@@ -286,7 +284,8 @@ export class TalkingFaceElement extends HTMLElement {
     );
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
-      detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name },
+      detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
+        avatar: this.avatar?.summary },
     }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
@@ -302,6 +301,7 @@ export class TalkingFaceElement extends HTMLElement {
       detail: {
         frame, time: frame / a.fps, mode: 'playback', backend: this.engine.backend,
         inferenceMs: this.computeMs / a.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
+        ...(a.blendshapes && frameWeights(a.blendshapes, frame)),
       },
     }));
   }

@@ -86,6 +86,17 @@ export class ContentEncoder {
     });
   }
 
+  /** Each frame's row of posteriors (frames x classes), at the content position heardPhones reads. */
+  framePosteriors(post: Float32Array, melIndex: number[], r: ContentRange): Float32Array {
+    const { content_stride: stride, content_classes: classes } = this.m;
+    const out = new Float32Array(melIndex.length * classes);
+    melIndex.forEach((k, i) => {
+      const row = (Math.floor(k / stride) - r.lo) * classes;
+      out.set(post.subarray(row, row + classes), i * classes);
+    });
+    return out;
+  }
+
   /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */
   async tokens(windows: Float32Array, frames: number): Promise<Float32Array> {
     const m = this.m;

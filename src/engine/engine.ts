@@ -19,10 +19,11 @@ import { HeadMotion, headMotionParams } from '../pose/head-motion';
 import { detectWebGPU } from '../gpu/capabilities';
 import type { FaceTemplate } from '../template/face-template';
 import { DecoderBackends, type Backend } from './backends';
+import type { AvatarWeights } from '../avatar/weights';
 import { DEFAULT_CHUNK_FRAMES, Pipeline } from './pipeline';
 import { StreamSession } from './stream';
 import { LiveSession, type LiveOptions } from './live';
-import { yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
+import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -54,12 +55,17 @@ export interface AnimateOptions {
   chunkFrames?: number;
   /** Called after each chunk with the frames done so far. */
   onProgress?: (done: number, total: number) => void;
-  /** Receives each chunk's frames instead of (or as well as) the returned buffer. */
-  onFrames?: (first: number, vertices: Float32Array, pose: Float32Array) => void;
+  /** Receives each chunk's frames instead of (or as well as) the returned buffer; `frames` has all of the chunk. */
+  onFrames?: (first: number, vertices: Float32Array, pose: Float32Array, frames: Frames) => void;
   /** false: do not keep all frames (use onFrames); memory then stays one chunk. Default true. */
   keep?: boolean;
   /** Also keep the unposed face I + O per frame (what a renderer that poses the head itself wants). */
   unposed?: boolean;
+  /**
+   * Also compute, per frame, the 52 ARKit blend-shape weights, the 15 Oculus visemes and the head's yaw, pitch and
+   * roll (Animation.blendshapes; src/avatar/, docs/avatar.md). Off by default: it costs a solve per frame.
+   */
+  blendshapes?: boolean;
   signal?: AbortSignal;
 }
 
@@ -170,7 +176,8 @@ export class TalkingFaceEngine {
     const pose = new Float32Array(F * 6);
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
     const phones = new Uint8Array(F);
-    const state = this.pipeline.newState();
+    const blendshapes = options.blendshapes ? emptyBlendshapes(F) : undefined;
+    const state = this.pipeline.newState({ blendshapes: options.blendshapes });
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
       options.signal?.throwIfAborted();
@@ -180,10 +187,11 @@ export class TalkingFaceEngine {
       if (keep) vertices.set(out.vertices, f0 * n * 3);
       unposed?.set(out.unposed, f0 * n * 3);
       phones.set(out.phones, f0);
-      options.onFrames?.(f0, out.vertices, out.pose);
+      if (blendshapes) setBlendshapes(blendshapes, out.blendshapes!, f0);
+      options.onFrames?.(f0, out.vertices, out.pose, out);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed, phones };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, blendshapes };
   }
 
   /**
@@ -200,14 +208,23 @@ export class TalkingFaceEngine {
     return this.reference.attention(inputs.tokens!, inputs.poseToken!, layer);
   }
 
-  /** Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. */
-  createStream(onFrames: (first: number, frames: Frames) => void, options: { maxLagFrames?: number } = {}): StreamSession {
-    return new StreamSession(this.pipeline, onFrames, options.maxLagFrames);
+  /**
+   * Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. `blendshapes`: the
+   * frames also carry ARKit weights, visemes and head rotations (as animate's option).
+   */
+  createStream(onFrames: (first: number, frames: Frames) => void, options: { maxLagFrames?: number; blendshapes?: boolean } = {}): StreamSession {
+    return new StreamSession(this.pipeline, onFrames, options.maxLagFrames, { blendshapes: options.blendshapes });
   }
 
   /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
   listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
-    return LiveSession.start(this.createStream(onFrames, { maxLagFrames: LiveSession.maxLag(options) }), media, options);
+    const stream = this.createStream(onFrames, { maxLagFrames: LiveSession.maxLag(options), blendshapes: options?.blendshapes });
+    return LiveSession.start(stream, media, options);
+  }
+
+  /** The ARKit basis and solver the `blendshapes` option uses (built on first use), e.g. to build an avatar from. */
+  get avatarWeights(): AvatarWeights {
+    return this.pipeline.avatarWeights;
   }
 
   /** Switch decoders at run time (the numbers are the same; only speed differs). */

@@ -1,4 +1,9 @@
 /** What the engine hands out: frames of a chunk, a whole animation, and how long each stage took. */
+import type { BlendshapeFrames } from '../avatar/weights';
+import { ARKIT_NAMES, VISEME_NAMES } from '../avatar/names';
+
+const ARKIT_COUNT = ARKIT_NAMES.length;
+const VISEME_COUNT = VISEME_NAMES.length;
 
 /** Frames of one chunk: posed vertices and I + O in the template's units, poses (axis-angle, mm). */
 export interface Frames {
@@ -8,6 +13,8 @@ export interface Frames {
   pose: Float32Array;
   /** (count): the content class heard most at each frame (manifest.content_phones). */
   phones: Uint8Array;
+  /** ARKit weights, visemes and head rotation per frame, when the stream was created with `blendshapes: true`. */
+  blendshapes?: BlendshapeFrames;
 }
 
 export interface Animation {
@@ -21,6 +28,8 @@ export interface Animation {
   unposed?: Float32Array;
   /** (frames): the content class the encoder heard most at each frame (names: manifest.content_phones). */
   phones: Uint8Array;
+  /** Per frame: 52 ARKit weights, 15 visemes, head yaw / pitch / roll (animate with `blendshapes: true`). */
+  blendshapes?: BlendshapeFrames;
 }
 
 /** Milliseconds spent in each stage since the last resetTimes(). */
@@ -31,6 +40,8 @@ export interface StageTimes {
   pose: number;
   decoder: number;
   posing: number;
+  /** The avatar stage (ARKit weights, visemes), when asked for. */
+  blendshapes: number;
 }
 
 /** Chunks of streamed frames joined into one animation (they must be consecutive). */
@@ -41,15 +52,29 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
   const unposed = new Float32Array(count * per);
   const pose = new Float32Array(count * 6);
   const phones = new Uint8Array(count);
+  const blendshapes = chunks.every((f) => f.blendshapes) && count > 0 ? emptyBlendshapes(count) : undefined;
   let i = 0;
   for (const f of chunks) {
     vertices.set(f.vertices, i * per);
     unposed.set(f.unposed, i * per);
     pose.set(f.pose, i * 6);
     phones.set(f.phones, i);
+    if (blendshapes) setBlendshapes(blendshapes, f.blendshapes!, i);
     i += f.count;
   }
-  return { fps, frames: count, vertices, pose, unposed, phones };
+  return { fps, frames: count, vertices, pose, unposed, phones, blendshapes };
+}
+
+/** Room for `frames` frames of blendshape output. */
+export function emptyBlendshapes(frames: number): BlendshapeFrames {
+  return { arkit: new Float32Array(frames * ARKIT_COUNT), visemes: new Float32Array(frames * VISEME_COUNT), headRotation: new Float32Array(frames * 3) };
+}
+
+/** Copy a chunk's blendshape output into `all` from frame `at`. */
+export function setBlendshapes(all: BlendshapeFrames, chunk: BlendshapeFrames, at: number): void {
+  all.arkit.set(chunk.arkit, at * ARKIT_COUNT);
+  all.visemes.set(chunk.visemes, at * VISEME_COUNT);
+  all.headRotation.set(chunk.headRotation, at * 3);
 }
 
 /** Resolve on a new task (not a microtask): lets the browser handle input, rendering and timers. */

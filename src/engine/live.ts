@@ -15,6 +15,8 @@ export interface LiveOptions extends CaptureOptions {
   maxLagFrames?: number;
   /** Called when processing a piece fails (the session stops). */
   onError?: (error: Error) => void;
+  /** Frames also carry ARKit weights, visemes and head rotations (Frames.blendshapes). */
+  blendshapes?: boolean;
 }
 
 export class LiveSession {

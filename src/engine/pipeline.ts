@@ -14,19 +14,25 @@ import { poseFrames } from '../pose/posing';
 import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
 import type { Frames, StageTimes } from './frames';
+import { AvatarWeights } from '../avatar/weights';
+import type { SolverState } from '../avatar/solver';
 
 /** Frames per chunk when the caller does not say: bounds memory and the WebGPU decoder's buffers. */
 export const DEFAULT_CHUNK_FRAMES = 96;
 
-/** What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last residuals. */
-export type ProducerState = PoseState & { head?: HeadMotionState };
+/**
+ * What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last
+ * residuals, and, when the frames carry ARKit weights, the solver's warm start.
+ */
+export type ProducerState = PoseState & { head?: HeadMotionState; blendshapes?: SolverState };
 
 export class Pipeline {
-  readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0 };
+  readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0, blendshapes: 0 };
   readonly mmPerUnit: number;
   readonly templateMm: Float32Array;
   /** The seed of the head's own motion (new states draw with it); null: the pose head's mean pose alone. */
   headSeed: number | null = 0;
+  private avatar: AvatarWeights | null = null;
 
   constructor(
     readonly manifest: Manifest,
@@ -68,8 +74,17 @@ export class Pipeline {
     return Math.max(0, (frameToMelIndex(next, a) - back) * a.hop - a.frame_size);
   }
 
-  newState(): ProducerState {
-    return this.pose.newState();
+  /** `blendshapes`: the frames also carry ARKit weights, visemes and head rotations (the avatar stage). */
+  newState(options: { blendshapes?: boolean } = {}): ProducerState {
+    const state: ProducerState = this.pose.newState();
+    if (options.blendshapes) state.blendshapes = this.avatarWeights.newState();
+    return state;
+  }
+
+  /** The avatar stage, built on first use (the ARKit basis of the template: a few hundred ms). */
+  get avatarWeights(): AvatarWeights {
+    this.avatar ??= new AvatarWeights(this.template, this.manifest.content_phones);
+    return this.avatar;
   }
 
   /**
@@ -123,6 +138,13 @@ export class Pipeline {
     }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
-    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+    const frames: Frames = { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+    if (state.blendshapes) {
+      t = performance.now();
+      const posteriors = this.content.framePosteriors(post, melIndex, range);
+      frames.blendshapes = this.avatarWeights.frames(state.blendshapes, decoded.offsets, decoded.pose, posteriors, frames.count);
+      this.times.blendshapes += performance.now() - t;
+    }
+    return frames;
   }
 }

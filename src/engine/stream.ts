@@ -33,8 +33,10 @@ export class StreamSession {
      * output equals the offline animation.
      */
     private readonly maxLagFrames = Infinity,
+    /** `blendshapes`: the frames also carry ARKit weights, visemes and head rotations (Frames.blendshapes). */
+    options: { blendshapes?: boolean } = {},
   ) {
-    this.state = pipeline.newState();
+    this.state = pipeline.newState(options);
   }
 
   get lookAheadMs(): number {

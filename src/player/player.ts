@@ -3,9 +3,19 @@
  * head pose), plays the take's audio with the face in sync on the AudioContext's clock, shows streamed frames
  * live, and says what is worth knowing about the audio (silence, clipping, length).
  */
-import type { FaceView } from '../render/face-view';
 import type { Animation, Frames } from '../engine/frames';
+import type { BlendshapeFrames } from '../avatar/weights';
 import { levels } from '../audio/decode';
+
+/** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
+export interface PlayerView {
+  /** A frame's unposed face I + O (template units). */
+  setVertices(vertices: Float32Array): void;
+  /** The head pose: axis-angle (radians) and translation (template units). */
+  setPose(rx: number, ry: number, rz: number, tx: number, ty: number, tz: number): void;
+  /** Frame `frame` of the take's (or stream's) ARKit weights, visemes and head rotation, when it carries them. */
+  setBlendshapes?(blendshapes: BlendshapeFrames, frame: number): void;
+}
 
 /** Longer clips get a note with the expected time (they still work: memory stays bounded). */
 export const LONG_CLIP_SECONDS = 120;
@@ -45,7 +55,7 @@ export class Player {
   private currentFrame = 0;
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
-  constructor(private readonly view: FaceView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
+  constructor(private readonly view: PlayerView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
 
   /**
    * A new take to show and play. `shape` maps frame f's unposed face to what is drawn (e.g. onto another
@@ -81,6 +91,7 @@ export class Player {
     this.currentFrame = f;
     const unposed = a.unposed.subarray(f * n3, (f + 1) * n3);
     this.view.setVertices(this.shape ? this.shape(f, unposed) : unposed);
+    if (a.blendshapes) this.view.setBlendshapes?.(a.blendshapes, f);
     this.pose(a.pose.subarray(f * 6, f * 6 + 6));
     this.options.onFrame?.(f);
   }
@@ -90,6 +101,7 @@ export class Player {
     const last = frames.count - 1;
     const n3 = frames.unposed.length / frames.count;
     this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
+    if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, last);
     this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
   }
 

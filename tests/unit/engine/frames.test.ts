@@ -1,6 +1,6 @@
 /** joinFrames (src/engine/frames.ts): streamed chunks become one animation, every array in order. */
 import { describe, expect, it } from 'vitest';
-import { joinFrames, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
+import { emptyBlendshapes, joinFrames, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
 
 const chunk = (first: number, count: number, n: number): Frames => ({
   count,
@@ -19,6 +19,20 @@ describe('joinFrames', () => {
     expect(Array.from(a.unposed!)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => -i));
     expect(Array.from(a.pose)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => i));
     expect(Array.from(a.phones)).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
+  });
+
+  it('joins the blend-shape output too, when every chunk carries it', () => {
+    const withWeights = (first: number, count: number): Frames => {
+      const c = chunk(first, count, 2);
+      const b = emptyBlendshapes(count);
+      for (let f = 0; f < count; f++) { b.arkit[f * 52] = first + f; b.visemes[f * 15] = first + f; b.headRotation[f * 3] = first + f; }
+      return { ...c, blendshapes: b };
+    };
+    const a = joinFrames([withWeights(0, 2), withWeights(2, 3)], 30);
+    expect(Array.from({ length: 5 }, (_, f) => a.blendshapes!.arkit[f * 52])).toEqual([0, 1, 2, 3, 4]);
+    expect(Array.from({ length: 5 }, (_, f) => a.blendshapes!.visemes[f * 15])).toEqual([0, 1, 2, 3, 4]);
+    expect(Array.from({ length: 5 }, (_, f) => a.blendshapes!.headRotation[f * 3])).toEqual([0, 1, 2, 3, 4]);
+    expect(joinFrames([withWeights(0, 2), chunk(2, 3, 2)], 30).blendshapes).toBeUndefined();
   });
 
   it('no chunks make an empty animation', () => {

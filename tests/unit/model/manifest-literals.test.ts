@@ -16,6 +16,7 @@ import { ROOT, loadManifest } from '../helpers/exported';
 const ALLOWED: Record<string, string> = {
   'src/app/export-ui.ts: 30': 'milliseconds to let a status line paint, not frames per second',
   'src/render/face-view.ts: 30': "the camera's vertical field of view in degrees, not frames per second",
+  'src/avatar/avatar-view.ts: 30': "the camera's vertical field of view in degrees, as the face view's",
   'src/component/talking-face.ts: 100': 'CSS percentages, not the feature rate',
 };
 

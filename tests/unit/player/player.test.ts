@@ -5,7 +5,8 @@
 import { afterEach, beforeEach, describe, expect, it } from 'vitest';
 import { Player, audioNotes, LONG_CLIP_SECONDS } from '../../../src/player/player';
 import type { FaceView } from '../../../src/render/face-view';
-import type { Animation } from '../../../src/engine/frames';
+import { emptyBlendshapes, type Animation } from '../../../src/engine/frames';
+import type { BlendshapeFrames } from '../../../src/avatar/weights';
 
 /** A face view that records what it was given. */
 function fakeView() {
@@ -72,6 +73,24 @@ describe('Player', () => {
     expect(seen).toEqual([3, 4]);
     expect(shown[0]).toEqual({ vertices: [3, 3, 3, 3, 3, 3], pose: [3, 3, 3, 3, 3, 3] }); // 30 mm x 0.1 units per mm
     expect(p.current).toBe(4);
+  });
+
+  it("hands a view that draws blend shapes (an avatar) the frame's weights, offline and live", () => {
+    const got: [number, number][] = [];
+    const view = { setVertices: () => undefined, setPose: () => undefined,
+      setBlendshapes: (b: BlendshapeFrames, f: number) => got.push([f, b.arkit[f * 52]]) };
+    const a = animation(4);
+    a.blendshapes = emptyBlendshapes(4);
+    a.blendshapes.arkit.set([0.5], 2 * 52);
+    const p = new Player(view, 1);
+    p.load(a, {} as AudioBuffer);
+    p.show(2);
+    expect(got).toEqual([[2, 0.5]]);
+    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), blendshapes: a.blendshapes });
+    expect(got[1]).toEqual([2, 0.5]); // the chunk's last frame
+    p.load(animation(4), {} as AudioBuffer); // a take without blend shapes: nothing to hand over
+    p.show(1);
+    expect(got).toHaveLength(2);
   });
 
   it('draws through the shape mapping when given one', () => {

@@ -1,0 +1,32 @@
+/**
+ * npm run make-avatars: the two test avatars, made from the face template and the ARKit basis (src/avatar/), no
+ * third-party asset: examples/avatars/arkit-face.glb (the 52 ARKit morph targets and a "Head" node) and
+ * examples/avatars/visemes-face.glb (only the 15 Oculus viseme targets, each a mix of the ARKit shapes). A unit
+ * test checks that the committed files are exactly what this writes.
+ */
+import { readFileSync, writeFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { decodeTemplate } from '../src/template/face-template';
+import { buildAvatarGlb } from '../src/avatar/avatar-mesh';
+import { installFileReader } from '../tests/unit/helpers/file-reader';
+
+const ROOT = resolve(import.meta.dirname, '..');
+
+export const AVATARS = { 'arkit-face.glb': 'arkit', 'visemes-face.glb': 'visemes' } as const;
+
+export async function makeAvatars(): Promise<Record<string, Uint8Array>> {
+  installFileReader();
+  const bin = readFileSync(resolve(ROOT, 'models/template/template.bin'));
+  const template = await decodeTemplate(JSON.parse(readFileSync(resolve(ROOT, 'models/template/template.json'), 'utf8')),
+    bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.byteLength) as ArrayBuffer);
+  const out: Record<string, Uint8Array> = {};
+  for (const [file, morphs] of Object.entries(AVATARS)) out[file] = new Uint8Array(await buildAvatarGlb(template, morphs));
+  return out;
+}
+
+if (process.argv[1] === import.meta.filename) {
+  for (const [file, bytes] of Object.entries(await makeAvatars())) {
+    writeFileSync(resolve(ROOT, 'examples/avatars', file), bytes);
+    console.log(`examples/avatars/${file}: ${(bytes.byteLength / 1024).toFixed(0)} kB`);
+  }
+}

@@ -1,0 +1,188 @@
+/**
+ * A user's glTF avatar bound to this project's output: its morph targets found by ARKit name or by Oculus viseme
+ * name (names.ts: case-insensitive, exporter prefixes stripped, `_L` / `_R` spelled out), and a head bone to turn
+ * with the predicted head pose. No renderer here (avatar-view.ts draws it), so it loads in Node too.
+ */
+import * as THREE from 'three';
+import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
+import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
+
+export class AvatarLoadError extends Error {
+  override name = 'AvatarLoadError';
+}
+
+/** One morph target driven by one output channel. */
+interface Target {
+  influences: number[];
+  at: number;
+  channel: number;
+}
+
+export interface AvatarSummary {
+  /** Which output drives the face: ARKit weights when the avatar has ARKit targets, else the visemes. */
+  scheme: 'arkit' | 'visemes';
+  /** ARKit (or viseme) names the avatar has, out of 52 (15). */
+  matched: string[];
+  /** The bone turned with the head pose, or null. */
+  headBone: string | null;
+}
+
+export class GltfAvatar {
+  private readonly rest = new THREE.Quaternion();
+  private readonly parentWorld = new THREE.Quaternion();
+  private readonly parentInverse = new THREE.Quaternion();
+
+  /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
+  private readonly modelBlink = [0, 0];
+  private idleBlink = 0;
+
+  private constructor(
+    readonly gltf: GLTF,
+    readonly scheme: 'arkit' | 'visemes',
+    private readonly targets: Target[],
+    readonly matched: string[],
+    readonly head: THREE.Object3D | null,
+    /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
+    private readonly blinkTargets: Target[],
+  ) {
+    if (head) {
+      gltf.scene.updateMatrixWorld(true);
+      this.rest.copy(head.quaternion);
+      head.parent?.getWorldQuaternion(this.parentWorld);
+      this.parentInverse.copy(this.parentWorld).invert();
+    }
+  }
+
+  /**
+   * Parse a .glb (or .gltf JSON) and bind it. `source` names the file in messages; `headBone` is the
+   * `avatar-head-bone` attribute (default: a bone named Head or head). Throws AvatarLoadError with what is wrong.
+   */
+  static async parse(bytes: ArrayBuffer, source: string, headBone?: string | null): Promise<GltfAvatar> {
+    const head = new Uint8Array(bytes, 0, Math.min(4, bytes.byteLength));
+    const magic = String.fromCharCode(...head);
+    const firstChar = String.fromCharCode(...new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength))).trimStart()[0];
+    if (magic !== 'glTF' && firstChar !== '{') {
+      const what = firstChar === '<' ? 'it is an HTML page: is the URL right?' : `a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}`;
+      throw new AvatarLoadError(`${source} is not a glTF file (${what}): export the avatar as .glb`);
+    }
+    const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+    let gltf: GLTF;
+    try {
+      gltf = await new GLTFLoader().parseAsync(bytes, folderOf(source));
+    } catch (e) {
+      throw new AvatarLoadError(`${source} could not be read as glTF: ${(e as Error).message}`);
+    }
+    return GltfAvatar.bind(gltf, source, headBone);
+  }
+
+  /** Bind a loaded glTF: find its targets and head bone. */
+  static bind(gltf: GLTF, source: string, headBone?: string | null): GltfAvatar {
+    const arkit: Target[] = [];
+    const visemes: Target[] = [];
+    const names = new Set<string>();
+    gltf.scene.traverse((o) => {
+      const mesh = o as THREE.Mesh;
+      if (!mesh.morphTargetDictionary || !mesh.morphTargetInfluences) return;
+      for (const [name, at] of Object.entries(mesh.morphTargetDictionary)) {
+        names.add(name);
+        const a = arkitIndexOf(name), v = visemeIndexOf(name);
+        if (a >= 0) arkit.push({ influences: mesh.morphTargetInfluences, at, channel: a });
+        if (v >= 0) visemes.push({ influences: mesh.morphTargetInfluences, at, channel: v });
+      }
+    });
+    if (!arkit.length && !visemes.length) {
+      const found = names.size ? `its morph targets are: ${[...names].slice(0, 60).join(', ')}${names.size > 60 ? ', …' : ''}` : 'it has no morph targets at all';
+      throw new AvatarLoadError(`${source} has no morph targets named after ARKit's 52 blend shapes (jawOpen, eyeBlinkLeft, …) ` +
+        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …); ${found}. Rename them (docs/embedding.md, "Avatars").`);
+    }
+    const scheme = arkit.length ? 'arkit' : 'visemes';
+    const targets = scheme === 'arkit' ? arkit : visemes;
+    const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
+    const matched = [...new Set(targets.map((t) => all[t.channel]))];
+    const blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
+      .map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
+    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone), blinks);
+  }
+
+  get summary(): AvatarSummary {
+    return { scheme: this.scheme, matched: this.matched, headBone: this.head?.name ?? null };
+  }
+
+  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets). */
+  get canBlink(): boolean {
+    return this.blinkTargets.length > 0;
+  }
+
+  /** Set the morph targets from one frame of output: ARKit weights (52) and visemes (15), each from its index `at`. */
+  setWeights(arkit: ArrayLike<number>, arkitAt: number, visemes: ArrayLike<number>, visemesAt: number): void {
+    const [values, at] = this.scheme === 'arkit' ? [arkit, arkitAt] : [visemes, visemesAt];
+    for (const t of this.targets) t.influences[t.at] = values[at + t.channel];
+    this.modelBlink[0] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkLeft];
+    this.modelBlink[1] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkRight];
+    this.applyBlink();
+  }
+
+  /** An idle blink's lid closure (blinks.ts) on top of the model's own eyeBlink weights. */
+  setIdleBlink(amount: number): void {
+    this.idleBlink = amount;
+    this.applyBlink();
+  }
+
+  /** Every driven morph target back to 0 and the head to its rest pose. */
+  reset(): void {
+    for (const t of this.targets) t.influences[t.at] = 0;
+    this.modelBlink.fill(0);
+    this.applyBlink();
+    this.head?.quaternion.copy(this.rest);
+  }
+
+  private applyBlink(): void {
+    for (const t of this.blinkTargets) t.influences[t.at] = Math.max(this.modelBlink[t.channel], this.idleBlink);
+  }
+
+  /**
+   * Turn the head bone by an axis-angle rotation (radians) given in the avatar's world axes (glTF's: +y up, the
+   * face towards +z, as the template's), about the bone's own pivot: the world rotation is carried into the
+   * bone's parent frame, then applied on top of the bone's rest rotation.
+   */
+  setHeadRotation(rx: number, ry: number, rz: number): void {
+    if (!this.head) return;
+    const angle = Math.hypot(rx, ry, rz);
+    if (angle < 1e-9) scratch.identity();
+    else scratch.setFromAxisAngle(axis.set(rx / angle, ry / angle, rz / angle), angle);
+    scratch.premultiply(this.parentInverse).multiply(this.parentWorld); // parent^-1 * delta * parent
+    this.head.quaternion.copy(scratch).multiply(this.rest);
+  }
+}
+
+/** The folder a .gltf's external files are read from ('' for a blob: or data: URL, which has none). */
+function folderOf(source: string): string {
+  try {
+    const url = new URL(source, globalThis.location?.href ?? 'file:///');
+    return url.protocol === 'blob:' || url.protocol === 'data:' ? '' : new URL('.', url).href;
+  } catch {
+    return ''; // deliberate: a name that is no URL has no folder; an embedded .glb needs none
+  }
+}
+
+const scratch = new THREE.Quaternion();
+const axis = new THREE.Vector3();
+
+/** The head bone: the named one, else a bone (or node) named Head / head, else one whose name ends in "head". */
+function findHead(scene: THREE.Object3D, source: string, name?: string | null): THREE.Object3D | null {
+  const nodes: THREE.Object3D[] = [];
+  scene.traverse((o) => nodes.push(o));
+  if (name) {
+    const found = nodes.find((o) => o.name === name);
+    if (!found) {
+      const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
+      const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);
+      throw new AvatarLoadError(`${source} has no node named "${name}" (avatar-head-bone); ` +
+        `its ${bones.length ? 'bones' : 'nodes'} are: ${named.slice(0, 60).join(', ')}`);
+    }
+    return found;
+  }
+  return nodes.find((o) => o.name === 'Head' || o.name === 'head')
+    ?? nodes.find((o) => (o as THREE.Bone).isBone && /(^|[^a-z])head$/i.test(o.name.replace(/^mixamorig:?/i, '')))
+    ?? null;
+}

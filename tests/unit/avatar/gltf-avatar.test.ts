@@ -1,0 +1,113 @@
+/**
+ * Binding a glTF avatar (src/avatar/gltf-avatar.ts) in Node: the project's test avatars (examples/avatars/, exactly
+ * what npm run make-avatars writes), which naming scheme drives them, the head bone found and turned about its
+ * pivot under a rotated parent, the idle blink, and the messages for files that cannot be used.
+ */
+import { beforeAll, describe, expect, it } from 'vitest';
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import * as THREE from 'three';
+import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
+import { GltfAvatar } from '../../../src/avatar/gltf-avatar';
+import { ARKIT_NAMES, VISEME_NAMES } from '../../../src/avatar/names';
+import { AVATARS, makeAvatars } from '../../../scripts/make-avatars';
+import { ROOT } from '../helpers/exported';
+
+const file = (name: string) => {
+  const b = readFileSync(resolve(ROOT, 'examples/avatars', name));
+  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer;
+};
+const influences = (a: GltfAvatar) => {
+  let mesh: THREE.Mesh | null = null;
+  a.gltf.scene.traverse((o) => { if ((o as THREE.Mesh).morphTargetInfluences) mesh = o as THREE.Mesh; });
+  const m = mesh as unknown as THREE.Mesh;
+  return (name: string) => m.morphTargetInfluences![m.morphTargetDictionary![name]];
+};
+/** A glTF stand-in: one mesh with morph targets of the given names, under the given bones. */
+function fake(names: string[], bones: string[] = []): GLTF {
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3));
+  geometry.morphAttributes.position = names.map(() => new THREE.BufferAttribute(new Float32Array(9), 3));
+  const mesh = new THREE.Mesh(geometry);
+  mesh.updateMorphTargets();
+  mesh.morphTargetDictionary = Object.fromEntries(names.map((n, i) => [n, i]));
+  let parent: THREE.Object3D = new THREE.Scene();
+  const scene = parent;
+  for (const b of bones) { const bone = new THREE.Bone(); bone.name = b; parent.add(bone); parent = bone; }
+  parent.add(mesh);
+  return { scene, animations: [] } as unknown as GLTF;
+}
+
+describe('the test avatars', () => {
+  it('are exactly what npm run make-avatars writes', async () => {
+    const made = await makeAvatars();
+    for (const name of Object.keys(AVATARS)) expect(Buffer.compare(Buffer.from(made[name]), Buffer.from(file(name))), name).toBe(0);
+  });
+});
+
+describe('GltfAvatar', () => {
+  let arkit: GltfAvatar, visemes: GltfAvatar;
+  beforeAll(async () => {
+    arkit = await GltfAvatar.parse(file('arkit-face.glb'), 'arkit-face.glb');
+    visemes = await GltfAvatar.parse(file('visemes-face.glb'), 'visemes-face.glb');
+  });
+
+  it('drives an ARKit avatar by the 52 weights and a viseme-only avatar by the 15 visemes', () => {
+    expect(arkit.summary).toEqual({ scheme: 'arkit', matched: [...ARKIT_NAMES], headBone: 'Head' });
+    expect(visemes.summary).toEqual({ scheme: 'visemes', matched: [...VISEME_NAMES], headBone: 'Head' });
+    const w = Float32Array.from(ARKIT_NAMES, (_, k) => k / 100);
+    const v = Float32Array.from(VISEME_NAMES, (_, k) => k / 20);
+    arkit.setWeights(w, 0, v, 0);
+    visemes.setWeights(w, 0, v, 0);
+    expect(influences(arkit)('jawOpen')).toBeCloseTo(ARKIT_NAMES.indexOf('jawOpen') / 100, 6);
+    expect(influences(visemes)('viseme_aa')).toBeCloseTo(VISEME_NAMES.indexOf('viseme_aa') / 20, 6);
+    expect(arkit.canBlink).toBe(true);
+    expect(visemes.canBlink).toBe(false);
+    arkit.setIdleBlink(0.9); // on top of the model's own eyeBlink weight
+    expect(influences(arkit)('eyeBlinkLeft')).toBeCloseTo(0.9, 6);
+    arkit.setIdleBlink(0);
+    expect(influences(arkit)('eyeBlinkLeft')).toBeCloseTo(0, 6);
+    arkit.reset();
+    expect(influences(arkit)('jawOpen')).toBe(0);
+  });
+
+  it('finds prefixed and suffixed ARKit names, and prefers them to visemes when it has both', () => {
+    const a = GltfAvatar.bind(fake(['blendShape1.jawOpen', 'Mouth_Smile_L', 'viseme_aa', 'somethingElse']), 'x.glb');
+    expect(a.summary.scheme).toBe('arkit');
+    expect(a.summary.matched).toEqual(['jawOpen', 'mouthSmileLeft']);
+    expect(a.summary.headBone).toBeNull();
+  });
+
+  it('says what it found when neither scheme is there, and when the file is not glTF', async () => {
+    expect(() => GltfAvatar.bind(fake(['smile', 'blink', 'A']), 'face.glb')).toThrow(/face\.glb has no morph targets named after ARKit's 52 .* its morph targets are: smile, blink, A\./);
+    expect(() => GltfAvatar.bind(fake([]), 'bare.glb')).toThrow(/it has no morph targets at all/);
+    await expect(GltfAvatar.parse(new TextEncoder().encode('ID3\u0004 an mp3').buffer as ArrayBuffer, 'song.mp3')).rejects.toThrow(/song\.mp3 is not a glTF file .*starts with "ID3/);
+    const broken = new Uint8Array(file('arkit-face.glb').slice(0, 200)); // a .glb cut short
+    await expect(GltfAvatar.parse(broken.buffer, 'cut.glb')).rejects.toThrow(/cut\.glb could not be read as glTF/);
+  });
+
+  it('finds the head bone: Head or head, a prefixed one (mixamorigHead, J_Bip_C_Head), or the one named', () => {
+    for (const [bones, head] of [[['Hips', 'Neck', 'Head'], 'Head'], [['root', 'head'], 'head'], [['mixamorigHips', 'mixamorigHead'], 'mixamorigHead'],
+      [['J_Bip_C_Neck', 'J_Bip_C_Head'], 'J_Bip_C_Head'], [['Hips', 'HeadTop_End'], null]] as const) {
+      expect(GltfAvatar.bind(fake(['jawOpen'], [...bones]), 'x.glb').summary.headBone, bones.join('/')).toBe(head);
+    }
+    expect(GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck', 'Skull']), 'x.glb', 'Skull').summary.headBone).toBe('Skull');
+    expect(() => GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck']), 'x.glb', 'Skull')).toThrow(/no node named "Skull" \(avatar-head-bone\); its bones are: Hips, Neck/);
+  });
+
+  it("turns the head about its pivot by a rotation given in world axes, whatever its parent's rotation", () => {
+    const gltf = fake(['jawOpen'], ['Hips', 'Head']);
+    const hips = gltf.scene.getObjectByName('Hips')!, head = gltf.scene.getObjectByName('Head')!;
+    hips.quaternion.setFromAxisAngle(new THREE.Vector3(0, 1, 0), Math.PI / 2); // a parent turned a quarter about y
+    head.quaternion.setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.2); // and the bone's own rest rotation
+    const a = GltfAvatar.bind(gltf, 'x.glb');
+    const restWorld = head.getWorldQuaternion(new THREE.Quaternion());
+    a.setHeadRotation(0.3, 0, 0); // nod about the world's x axis
+    gltf.scene.updateMatrixWorld(true);
+    const want = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.3).multiply(restWorld);
+    expect(head.getWorldQuaternion(new THREE.Quaternion()).angleTo(want)).toBeLessThan(1e-6);
+    a.reset();
+    gltf.scene.updateMatrixWorld(true);
+    expect(head.getWorldQuaternion(new THREE.Quaternion()).angleTo(restWorld)).toBeLessThan(1e-6);
+  });
+});
