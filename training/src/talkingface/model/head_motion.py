@@ -188,9 +188,10 @@ def fit(residuals: list[np.ndarray], feats: list[np.ndarray], pivot_mm: np.ndarr
     W, b = fit_steps(F, E)
     sigma_mean = np.logaddexp(0.0, F @ W.T + b).mean(0)
     head = HeadMotion(ar=ar, sigma_w=W, sigma_b=b, sigma_mean=sigma_mean, pivot_mm=np.asarray(pivot_mm, np.float64), gain=np.ones(3))
-    # The gain: the truth's mean within-clip spread over the process's on the same clips (three draws each).
+    # The gain: the truth's mean within-clip spread over the process's on the same clips (three draws each, every
+    # draw its own seed: one seed gives every clip the same draws, and so one sample of the spread, not its mean).
     want = np.mean([r.std(0) for r in residuals], 0)
-    got = np.mean([head.sample(f, seed).std(0) for f in feats for seed in range(3)], 0)
+    got = np.mean([head.sample(f, 1000 * k + i).std(0) for i, f in enumerate(feats) for k in range(3)], 0)
     head.gain = want / got
     head.sigma_mean = sigma_mean * head.gain
     return head

@@ -46,7 +46,8 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
         if head is not None:
             feats, _ = hmodel.clip_features(model, c.mel, c.num_frames)
-            pred_pose = hmodel.compose(pred_pose, head.sample(feats, seed), head.pivot_mm)
+            # Clip i draws with seed + i: one seed would give every clip the same draws, and the measures one sample.
+            pred_pose = hmodel.compose(pred_pose, head.sample(feats, seed + i), head.pivot_mm)
             pred_posed = apply_pose_np(pred_unposed, pred_pose)
         gt_posed = apply_pose_np(c.vertices, c.pose)
         m = clip_metrics(c.vertices, pred_unposed, gt_posed, pred_posed, c.template, c.pose, pred_pose, regions)
@@ -107,7 +108,7 @@ def main(argv=None) -> int:
     ap.add_argument("--checkpoint", required=True)
     ap.add_argument("--split", default="test")
     ap.add_argument("--out", help="write the results JSON here")
-    ap.add_argument("--head-seed", type=int, default=0, help="seed of the head's own motion, as the browser's default (when the checkpoint has one)")
+    ap.add_argument("--head-seed", type=int, default=0, help="seed of the head's own motion (clip i draws with seed + i; when the checkpoint has one)")
     ap.add_argument("--mean-pose", action="store_true", help="measure the pose head's mean pose alone, without the head's own motion")
     args = ap.parse_args(argv)
     ds = open_dataset(args.corpus)

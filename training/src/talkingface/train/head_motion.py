@@ -103,6 +103,10 @@ def markdown(res: dict, plot_name: str) -> list[str]:
         "between the true and predicted speed distributions (degrees). Follows speech: correlation within a clip of",
         "the head's speed with the speech envelope's change, true / predicted. Jitter: true / predicted.",
         "",
+        *([f"Predicted: the pose head's mean pose plus the head's own motion (model/head_motion.py), test clip i drawn "
+           f"with seed {res['head_motion']['sampled']['seed']} + i (so the measures average many draws); `--mean-pose` "
+           "measures the mean alone (spread ratio 0.11 before the head's own motion).", ""]
+          if res["head_motion"].get("sampled") else ["Predicted: the pose head's mean pose alone.", ""]),
         "| clips | spread (deg) | spread ratio (pitch / yaw / roll) | speed (deg/frame) | speed W1 | follows speech | jitter (deg) |",
         "| --- | --- | --- | --- | --- | --- | --- |",
         *rows,
