@@ -281,7 +281,7 @@ export class TalkingFaceElement extends HTMLElement {
       }
     }
     engine.restFace().then(
-      (rest) => { if (!this.animation) this.view?.setVertices(rest); }, // the mouth closed at rest, not the opened template
+      (rest) => this.view?.setRestFace(rest), // the mouth closed at rest, not the opened template; idle life starts from it
       (e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`),
     );
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);

@@ -144,6 +144,7 @@ export class TalkingFaceEngine {
     const pose = new Float32Array(F * 6);
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
     const phones = new Uint8Array(F);
+    const tongue = new Float32Array(F);
     const state = this.pipeline.newState();
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
@@ -154,10 +155,11 @@ export class TalkingFaceEngine {
       if (keep) vertices.set(out.vertices, f0 * n * 3);
       unposed?.set(out.unposed, f0 * n * 3);
       phones.set(out.phones, f0);
+      tongue.set(out.tongue, f0);
       options.onFrames?.(f0, out.vertices, out.pose);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed, phones };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue };
   }
 
   /**

@@ -87,6 +87,7 @@ export class Pipeline {
     const post = await this.content.posteriors(mel, range);
     const windows = this.content.windows(post, melIndex, range, K);
     const phones = this.content.heardPhones(post, melIndex, range);
+    const tongue = this.content.tongueRaise(post, melIndex, range);
     this.times.content += performance.now() - t;
 
     t = performance.now();
@@ -113,6 +114,6 @@ export class Pipeline {
     t = performance.now();
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
-    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones, tongue };
   }
 }

@@ -80,7 +80,9 @@ export class Player {
     const f = Math.min(Math.max(0, Math.floor(frame)), a.frames - 1);
     this.currentFrame = f;
     const unposed = a.unposed.subarray(f * n3, (f + 1) * n3);
+    this.view.setTongue(a.tongue[f] ?? 0);
     this.view.setVertices(this.shape ? this.shape(f, unposed) : unposed);
+    this.view.setSpeaking(true);
     this.pose(a.pose.subarray(f * 6, f * 6 + 6));
     this.options.onFrame?.(f);
   }
@@ -89,7 +91,9 @@ export class Player {
   showLive(frames: Frames): void {
     const last = frames.count - 1;
     const n3 = frames.unposed.length / frames.count;
+    this.view.setTongue(frames.tongue[last] ?? 0);
     this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
+    this.view.setSpeaking(true);
     this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
   }
 
@@ -126,6 +130,7 @@ export class Player {
           return;
         }
         this.show(a.frames - 1);
+        this.view.setSpeaking(false); // after speech, back to the face at rest
         resolve();
         this.options.onEnded?.();
       };

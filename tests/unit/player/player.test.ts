@@ -10,12 +10,15 @@ import type { Animation } from '../../../src/engine/frames';
 /** A face view that records what it was given. */
 function fakeView() {
   const shown: { vertices: number[]; pose: number[] }[] = [];
+  const speaking: boolean[] = [];
   let last: number[] = [];
   const view = {
     setVertices: (v: Float32Array) => (last = Array.from(v)),
     setPose: (...p: number[]) => shown.push({ vertices: last, pose: p }),
+    setTongue: () => undefined,
+    setSpeaking: (on: boolean) => speaking.push(on),
   } as unknown as FaceView;
-  return { view, shown };
+  return { view, shown, speaking };
 }
 
 /** Two vertices, `frames` frames: vertex values f, poses f (rotation) and 10 f (mm). */
@@ -26,6 +29,7 @@ function animation(frames: number): Animation {
     unposed: Float32Array.from({ length: frames * 6 }, (_, i) => Math.floor(i / 6)),
     pose: Float32Array.from({ length: frames * 6 }, (_, i) => (i % 6 < 3 ? Math.floor(i / 6) : 10 * Math.floor(i / 6))),
     phones: new Uint8Array(frames),
+    tongue: new Float32Array(frames),
   };
 }
 
