@@ -31,7 +31,7 @@ export class Eyes {
       for (const v of loop) box.expandByPoint(scratch.fromArray(template.positions, 3 * v));
       const size = box.getSize(new THREE.Vector3());
       const center = box.getCenter(new THREE.Vector3());
-      const radius = size.x * 0.56;
+      const radius = size.x * 0.62;
       const eye = new THREE.Group();
       eye.name = `eye_${side}`;
       eye.rotation.order = 'YXZ';
@@ -88,7 +88,7 @@ export function eyeTexture(): THREE.Texture {
       if (a < PUPIL_EDGE) c = [8, 6, 6];
       else if (a < IRIS_EDGE) {
         const t = (a - PUPIL_EDGE) / (IRIS_EDGE - PUPIL_EDGE);
-        const base = [74 + 40 * t, 92 + 28 * t, 70 + 10 * t]; // hazel-green, lighter outwards
+        const base = [70 + 50 * t, 52 + 40 * t, 34 + 20 * t]; // brown, lighter outwards
         c = base.map((v) => v * (0.7 + 0.5 * streak) * (a > IRIS_EDGE - 3.5 ? 0.55 : 1)); // the limbus
       } else {
         const t = Math.min(1, (a - IRIS_EDGE) / 70);

@@ -15,8 +15,10 @@
 import type { FaceTemplate } from '../template/face-template';
 import { boundaryLoops } from '../template/mesh-topology';
 
-/** Rings from the oval to the back pole (the pole is one more vertex). */
-const RINGS = 14;
+/** Rings from the oval to the back pole (the pole is one more vertex); rings after the oval have twice its columns. */
+const RINGS = 18;
+/** The egg's squareness: 2 is an ellipsoid; more fills out the crown and the temples as a skull does. */
+const SQUARENESS = 2.5;
 
 /** The egg the shell lies on: centre and the four half-axes (template units). */
 export interface Egg {
@@ -93,18 +95,22 @@ export function ovalLoop(t: FaceTemplate): number[] | null {
   return best && bestHits >= 0.5 * oval.size ? best : null;
 }
 
-/** A point of the egg: direction angles theta (around the back axis) and phi (from the back pole). */
+/**
+ * A point of the egg (a superellipsoid with a half-axis per direction) at direction angles theta (around the back
+ * axis) and phi (from the back pole): the unit direction u, scaled by the half-axes and pulled onto the surface.
+ */
 function eggPoint(e: Egg, theta: number, phi: number, out: number[]): void {
   const s = Math.sin(phi);
   const ux = s * Math.cos(theta);
   const uy = s * Math.sin(theta);
   const uz = -Math.cos(phi);
-  out[0] = e.center[0] + ux * e.ax;
-  out[1] = e.center[1] + uy * (uy >= 0 ? e.up : e.down);
-  out[2] = e.center[2] + uz * (uz >= 0 ? e.front : e.back);
+  const k = (Math.abs(ux) ** SQUARENESS + Math.abs(uy) ** SQUARENESS + Math.abs(uz) ** SQUARENESS) ** (-1 / SQUARENESS);
+  out[0] = e.center[0] + k * ux * e.ax;
+  out[1] = e.center[1] + k * uy * (uy >= 0 ? e.up : e.down);
+  out[2] = e.center[2] + k * uz * (uz >= 0 ? e.front : e.back);
 }
 
-/** The egg's angles of a point (the inverse of eggPoint's direction, ignoring the distance). */
+/** The egg's angles of a point (the inverse of eggPoint's direction: the point's direction in half-axis units). */
 function eggAngles(e: Egg, x: number, y: number, z: number): { theta: number; phi: number } {
   const ux = (x - e.center[0]) / e.ax;
   const uy = (y - e.center[1]) / (y >= e.center[1] ? e.up : e.down);
@@ -135,38 +141,51 @@ export function headShell(t: FaceTemplate): HeadShell | null {
   const egg = eggFor(m);
   const p = t.positions;
   const M = loop.length;
-  const S = M * (RINGS - 1) + 1;
+  const C = 2 * M; // columns after the oval: each oval vertex's meridian and one between it and the next
+  const S = C * (RINGS - 1) + 1;
   const positions = new Float32Array(S * 3);
   const jawWeights = new Float32Array(S);
   const q = [0, 0, 0];
   const W = m.mouthWidth;
-  loop.forEach((v, i) => {
+  // Each oval vertex: its egg angles, its offset from the egg, and how much it turns with the jaw.
+  const seam = loop.map((v) => {
     const x = p[3 * v], y = p[3 * v + 1], z = p[3 * v + 2];
     const { theta, phi } = eggAngles(egg, x, y, z);
     eggPoint(egg, theta, phi, q);
-    const off = [x - q[0], y - q[1], z - q[2]];
     // The corpus rig's mandible: fully turning below corner - 0.45 W, still above corner + 0.3 W.
-    const jawSeam = Math.min(1, Math.max(0, (m.cornerY + 0.3 * W - y) / (0.75 * W)));
+    return { theta, phi, off: [x - q[0], y - q[1], z - q[2]], jaw: Math.min(1, Math.max(0, (m.cornerY + 0.3 * W - y) / (0.75 * W))) };
+  });
+  for (let c = 0; c < C; c++) {
+    const a = seam[Math.floor(c / 2)], b = seam[(Math.floor(c / 2) + (c % 2)) % M];
+    let dTheta = b.theta - a.theta;
+    if (dTheta > Math.PI) dTheta -= 2 * Math.PI;
+    else if (dTheta < -Math.PI) dTheta += 2 * Math.PI;
+    const theta = a.theta + dTheta / 2, phi = (a.phi + b.phi) / 2;
+    const off = a.off.map((o, k) => (o + b.off[k]) / 2);
+    const jaw = (a.jaw + b.jaw) / 2;
     for (let k = 1; k < RINGS; k++) {
       const s = k / RINGS;
       const fade = s >= 0.5 ? 0 : (1 - 2 * s) ** 2 * (1 + 4 * s); // 1 at the oval, flat there, 0 from halfway
       eggPoint(egg, theta, phi * (1 - s), q);
-      const at = 3 * ((k - 1) * M + i);
-      positions[at] = q[0] + off[0] * fade;
-      positions[at + 1] = q[1] + off[1] * fade;
-      positions[at + 2] = q[2] + off[2] * fade;
-      jawWeights[(k - 1) * M + i] = jawSeam * Math.max(0, 1 - s / 0.3);
+      const j = (k - 1) * C + c;
+      positions[3 * j] = q[0] + off[0] * fade;
+      positions[3 * j + 1] = q[1] + off[1] * fade;
+      positions[3 * j + 2] = q[2] + off[2] * fade;
+      jawWeights[j] = jaw * Math.max(0, 1 - s / 0.3);
     }
-  });
+  }
   eggPoint(egg, 0, 0, q);
   positions.set(q, 3 * (S - 1));
 
-  // Ring r's vertex i in the joined buffer: the oval itself for r = 0.
-  const id = (r: number, i: number) => (r === 0 ? loop[i % M] : n + (r - 1) * M + (i % M));
+  // Ring r's column c in the joined buffer (r >= 1), and the oval's vertex i (ring 0).
+  const id = (r: number, c: number) => n + (r - 1) * C + (c % C);
+  const oval = (i: number) => loop[i % M];
   const tris: number[] = [];
-  for (let r = 0; r + 1 < RINGS; r++)
-    for (let i = 0; i < M; i++) tris.push(id(r, i), id(r + 1, i), id(r + 1, i + 1), id(r, i), id(r + 1, i + 1), id(r, i + 1));
-  for (let i = 0; i < M; i++) tris.push(id(RINGS - 1, i), n + S - 1, id(RINGS - 1, i + 1));
+  for (let i = 0; i < M; i++) // the oval's M columns fan out to ring 1's 2M
+    tris.push(oval(i), id(1, 2 * i), id(1, 2 * i + 1), oval(i), id(1, 2 * i + 1), oval(i + 1), oval(i + 1), id(1, 2 * i + 1), id(1, 2 * i + 2));
+  for (let r = 1; r + 1 < RINGS; r++)
+    for (let c = 0; c < C; c++) tris.push(id(r, c), id(r + 1, c), id(r + 1, c + 1), id(r, c), id(r + 1, c + 1), id(r, c + 1));
+  for (let c = 0; c < C; c++) tris.push(id(RINGS - 1, c), n + S - 1, id(RINGS - 1, c + 1));
   const triangles = Uint32Array.from(tris);
   orientOutward(triangles, (v) => (v < n ? [p[3 * v], p[3 * v + 1], p[3 * v + 2]] : [positions[3 * (v - n)], positions[3 * (v - n) + 1], positions[3 * (v - n) + 2]]), egg.center);
   return { positions, triangles, seam: loop, jawWeights, egg, measures: m };

@@ -9,9 +9,9 @@ import { lipMask, type FaceTemplate } from '../template/face-template';
 import { eyeTexture } from './eyes';
 
 export const BACKGROUND = 0x1d2230;
-export const SKIN = new THREE.Color(0xd9a48a);
-const CHEEK = new THREE.Color(0xd98f7e);
-const LIP = new THREE.Color(0xb0605f);
+export const SKIN = new THREE.Color(0xc4927a);
+const CHEEK = new THREE.Color(0xc9766a);
+const LIP = new THREE.Color(0xa4504f);
 const HAIR = new THREE.Color(0x2b1d16);
 
 export function skinMaterial(): THREE.MeshPhysicalMaterial {
@@ -24,7 +24,7 @@ export function skinMaterial(): THREE.MeshPhysicalMaterial {
 
 /** The inside of the mouth: dark, wet and reddish; seen from inside (its back faces). */
 export function cavityMaterial(): THREE.MeshPhysicalMaterial {
-  return new THREE.MeshPhysicalMaterial({ name: 'mouth', color: 0x3a1216, roughness: 0.5, side: THREE.DoubleSide, envMapIntensity: 0.3 });
+  return new THREE.MeshPhysicalMaterial({ name: 'mouth', color: 0x2e0e12, roughness: 0.8, side: THREE.DoubleSide, envMapIntensity: 0.1 });
 }
 
 export function teethMaterial(): THREE.MeshPhysicalMaterial {
@@ -75,9 +75,10 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
   if (shell && egg) {
     for (let i = 0; i < s; i++) {
       const y = shell[3 * i + 1] - egg.center[1], z = shell[3 * i + 2] - egg.center[2];
-      // The hairline: 45% of the way up the crown at the front, down to the ears' height at the back.
-      const line = egg.up * (0.45 - 0.7 * Math.max(0, -z / egg.back));
-      const h = Math.min(1, Math.max(0, (y - line) / (0.12 * egg.up)));
+      // The hairline: at the face's top in front, above the ears at the sides, down to the nape at the back.
+      const back = Math.min(1, Math.max(0, -z / egg.back));
+      const line = z > 0 ? egg.up * (0.1 + 0.4 * Math.min(1, z / (0.4 * egg.back))) : egg.up * (0.1 - 1.0 * back * back);
+      const h = Math.min(1, Math.max(0, (y - line) / (0.15 * egg.up)));
       c.copy(SKIN).lerp(HAIR, h).toArray(colors, 3 * (n + i));
     }
   }
@@ -89,20 +90,20 @@ export function lightScene(scene: THREE.Scene, renderer: THREE.WebGLRenderer): v
   const pmrem = new THREE.PMREMGenerator(renderer);
   const room = new RoomEnvironment();
   scene.environment = pmrem.fromScene(room, 0.04).texture;
-  scene.environmentIntensity = 0.55;
+  scene.environmentIntensity = 0.35;
   room.dispose();
   pmrem.dispose();
   scene.background = new THREE.Color(BACKGROUND);
-  scene.add(new THREE.HemisphereLight(0xfff1e6, 0x3a3036, 0.55));
-  const key = new THREE.DirectionalLight(0xfff0e0, 2.1);
+  scene.add(new THREE.HemisphereLight(0xfff1e6, 0x3a3036, 0.35));
+  const key = new THREE.DirectionalLight(0xfff0e0, 2.4);
   key.position.set(0.7, 0.9, 1.4);
   const fill = new THREE.DirectionalLight(0xc8d8ff, 0.5);
   fill.position.set(-1.2, 0.1, 0.9);
   const rim = new THREE.DirectionalLight(0xaec4ff, 1.1);
   rim.position.set(-0.6, 0.7, -1.2);
   scene.add(key, fill, rim);
-  renderer.toneMapping = THREE.ACESFilmicToneMapping;
-  renderer.toneMappingExposure = 1.05;
+  renderer.toneMapping = THREE.NeutralToneMapping;
+  renderer.toneMappingExposure = 0.95;
 }
 
 /** A blue -> cyan -> green -> yellow -> red ramp at t in [0, 1], written to out[at..at+3) (painted maps). */

@@ -150,7 +150,7 @@ function arch(f: MouthFrame, upper: boolean): THREE.BufferGeometry {
     widths.forEach((w, k) => {
       const mid = x + w / 2;
       x += w * 0.95;
-      const tooth = new RoundedBoxGeometry(w * 0.92, height * (k < 3 ? 1 : 0.8), (k < 2 ? 0.055 : 0.1 + 0.02 * k) * W, 2, w * 0.15);
+      const tooth = new RoundedBoxGeometry(w * 0.98, height * (k < 3 ? 1 : 0.8), (k < 2 ? 0.055 : 0.1 + 0.02 * k) * W, 2, w * 0.15);
       const slope = (2 * 0.55 * mid) / (0.55 * W) ** 2 * W;
       tooth.rotateY(-side * Math.atan(slope));
       // Each crown hangs from (upper) or stands on (lower) the gum line, its biting edge at `edge`.
@@ -173,7 +173,7 @@ export function tongueGeometry(f: MouthFrame): THREE.BufferGeometry {
   const W = f.W;
   const g = new THREE.SphereGeometry(1, 28, 14);
   g.scale(0.4 * W, 0.16 * W, 0.62 * W);
-  const cy = f.lowerY - 0.2 * W, cz = f.frontZ - 0.8 * W;
+  const cy = f.lowerY - 0.15 * W, cz = f.frontZ - 0.72 * W;
   g.translate(f.center[0], cy, cz);
   const pos = g.getAttribute('position') as THREE.BufferAttribute;
   const raise = new Float32Array(pos.count * 3);
