@@ -40,7 +40,6 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   if (frames < 1) throw new Error('exportGlb: the animation has no frames');
   // The whole head (render/head.ts): face + shell + mouth cavity in one buffer, posed frame by frame like the view.
   const head = new Head(template);
-  for (const side of ['left', 'right']) head.group.getObjectByName(`cornea_${side}`)?.removeFromParent(); // additive: glTF has no such blending
   const base = head.vertices.slice();
   const dims = base.length;
   const n3 = template.vertexCount * 3;
@@ -111,12 +110,13 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
 function gazeTracks(head: Head, times: Float32Array): THREE.KeyframeTrack[] {
   const idle = new IdleMotion(1);
   const ahead = new THREE.Vector3();
+  const far = head.measures.top - head.measures.chin; // a viewer in front, far compared with the eyes' spacing
   const tracks: THREE.KeyframeTrack[] = [];
   const per = [new Float32Array(times.length * 4), new Float32Array(times.length * 4)];
   times.forEach((t, f) => {
     const s = idle.at(t);
     const eyes = head.eyes;
-    ahead.set(eyes.centers[0].x / 2 + eyes.centers[1].x / 2, eyes.centers[0].y, eyes.centers[0].z + 100);
+    ahead.set(eyes.centers[0].x / 2 + eyes.centers[1].x / 2, eyes.centers[0].y, eyes.centers[0].z + 10 * far);
     eyes.lookAt(ahead, s.yaw, s.pitch);
     eyes.left.quaternion.toArray(per[0], f * 4);
     eyes.right.quaternion.toArray(per[1], f * 4);

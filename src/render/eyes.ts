@@ -1,6 +1,6 @@
 /**
  * Eyeballs in the sockets behind the lids: a sclera with iris, limbus and pupil painted on it (a texture drawn in
- * code), a clear cornea over the iris that catches the lights, and gaze: each eye turns about its centre towards
+ * code), under a clear coat that catches the lights as the cornea does (materials.ts), and gaze: each eye turns about its centre towards
  * a target in the head's frame. The lids are the face's own vertices, so the model's blinks (and the idle blinks,
  * eyelids.ts) close them over the eyes.
  *
@@ -8,7 +8,7 @@
  */
 import * as THREE from 'three';
 import type { FaceTemplate } from '../template/face-template';
-import { eyeMaterials } from './materials';
+import { eyeMaterial } from './materials';
 
 /** Largest turn of the eyes from straight ahead (radians): people turn the head beyond about this. */
 const MAX_TURN = 0.45;
@@ -21,7 +21,7 @@ export class Eyes {
   readonly centers: THREE.Vector3[];
 
   constructor(template: FaceTemplate) {
-    const { sclera, cornea } = eyeMaterials();
+    const material = eyeMaterial();
     const groups: THREE.Group[] = [];
     this.centers = [];
     for (const side of ['left', 'right'] as const) {
@@ -37,18 +37,11 @@ export class Eyes {
       eye.rotation.order = 'YXZ';
       const ballGeometry = new THREE.SphereGeometry(radius, 40, 24);
       ballGeometry.rotateX(Math.PI / 2); // the texture's pole (the iris) looks along +z
-      const ball = new THREE.Mesh(ballGeometry, sclera);
+      const ball = new THREE.Mesh(ballGeometry, material);
       ball.name = `eyeball_${side}`;
-      // The cornea: a clear cap over the iris, bulging a little in front of the ball.
-      const capGeometry = new THREE.SphereGeometry(radius * 0.62, 32, 8, 0, Math.PI * 2, 0, 0.75);
-      capGeometry.rotateX(Math.PI / 2);
-      capGeometry.translate(0, 0, radius * 0.42);
-      const cap = new THREE.Mesh(capGeometry, cornea);
-      cap.name = `cornea_${side}`;
-      cap.renderOrder = 1;
-      eye.add(ball, cap);
-      // The front of the cornea sits just behind the deepest lid vertex, so lids close in front of it.
-      eye.position.set(center.x, center.y - size.y * 0.08, box.max.z - radius * 1.06 - size.z * 0.12);
+      eye.add(ball);
+      // The front of the ball sits just behind the deepest lid vertex, so lids close in front of it.
+      eye.position.set(center.x, center.y - size.y * 0.08, box.max.z - radius * 1.02 - size.z * 0.12);
       this.centers.push(eye.position.clone());
       groups.push(eye);
     }
@@ -88,7 +81,7 @@ export function eyeTexture(): THREE.Texture {
       if (a < PUPIL_EDGE) c = [8, 6, 6];
       else if (a < IRIS_EDGE) {
         const t = (a - PUPIL_EDGE) / (IRIS_EDGE - PUPIL_EDGE);
-        const base = [70 + 50 * t, 52 + 40 * t, 34 + 20 * t]; // brown, lighter outwards
+        const base = [70 + 48 * t, 52 + 40 * t, 34 + 20 * t]; // brown, lighter outwards
         c = base.map((v) => v * (0.7 + 0.5 * streak) * (a > IRIS_EDGE - 3.5 ? 0.55 : 1)); // the limbus
       } else {
         const t = Math.min(1, (a - IRIS_EDGE) / 70);

@@ -57,6 +57,7 @@ export class FaceView {
   private frameHandle = 0;
   private lastTime = -1;
   private readonly faceRadius: number;
+  private readonly environment: THREE.Texture;
   private readonly bodyHeight: number;
   private arrows: { template: THREE.ArrowHelper; current: THREE.ArrowHelper } | null = null;
 
@@ -67,10 +68,10 @@ export class FaceView {
   ) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
     this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
-    lightScene(this.scene, this.renderer);
     this.model = new Head(template);
     this.head = this.model.group;
     this.scene.add(this.head, this.model.body);
+    this.environment = lightScene(this.scene, this.renderer);
     this.shown = new Float32Array(template.positions);
     this.frame = new Float32Array(template.positions);
     this.blink = blinkField(template);
@@ -133,10 +134,9 @@ export class FaceView {
     this.requestRender();
   }
 
-  /** How raised the tongue is in this frame, 0..1 (Frames.tongue). */
+  /** How raised the tongue is, 0..1 (Frames.tongue): drawn with the next setVertices (give it first). */
   setTongue(raise: number): void {
     this.tongue = raise;
-    this.compose();
   }
 
   /** Head pose y = R x + t: axis-angle (radians) and translation (template units), applied to the whole head. */
@@ -243,7 +243,7 @@ export class FaceView {
     this.resizeObserver.disconnect();
     this.controls.dispose();
     this.model.dispose();
-    this.scene.environment?.dispose();
+    this.environment.dispose();
     this.renderer.dispose();
   }
 

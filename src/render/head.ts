@@ -14,6 +14,7 @@ import { headShell, faceMeasures, ovalLoop, type HeadShell, type FaceMeasures } 
 import { JawEstimator, jawHinge, turnAboutHinge, type Hinge } from './jaw';
 import { mouthBag, mouthFrame, teethGeometry, tongueGeometry, updateBag, type MouthBag } from './mouth-interior';
 import { Eyes } from './eyes';
+import { PartialNormals } from './normals';
 import { SKIN, cavityMaterial, clothMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
 
 const scratch = [0, 0];
@@ -40,6 +41,8 @@ export class Head {
   jawAngle = 0;
   private readonly estimator: JawEstimator;
   private readonly positions: THREE.BufferAttribute;
+  private readonly normals: THREE.BufferAttribute;
+  private readonly partialNormals: PartialNormals;
   private readonly n: number;
 
   constructor(readonly template: FaceTemplate) {
@@ -70,6 +73,13 @@ export class Head {
     geometry.setIndex([...skinTris, ...bagTris]);
     geometry.addGroup(0, skinTris.length, 0);
     if (bagTris.length) geometry.addGroup(skinTris.length, bagTris.length, 1);
+    // What moves per frame: the face, the shell where it turns with the jaw, the mouth's cavity.
+    const jawW = this.shell?.jawWeights;
+    const moving = (v: number) => v < this.n || v >= this.n + S || (jawW !== undefined && jawW[v - this.n] > 0);
+    this.partialNormals = new PartialNormals(geometry.getIndex()!.array, all, moving);
+    this.normals = new THREE.BufferAttribute(new Float32Array(all.length), 3);
+    this.partialNormals.init(all, this.normals.array as Float32Array);
+    geometry.setAttribute('normal', this.normals);
     this.skin = new THREE.Mesh(geometry, [skinMaterial(), cavityMaterial()]);
     this.skin.name = 'face';
 
@@ -145,7 +155,8 @@ export class Head {
     this.jaw.rotation.x = a;
     this.tongue.morphTargetInfluences![0] = tongue;
     this.positions.needsUpdate = true;
-    this.skin.geometry.computeVertexNormals();
+    this.partialNormals.update(all, this.normals.array as Float32Array);
+    this.normals.needsUpdate = true;
   }
 
   /** Paint the face's vertices with `colors` (N x 3), or restore the skin colours with null. */

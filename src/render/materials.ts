@@ -2,6 +2,13 @@
  * How the head looks: physical materials for skin, lips, eyes, teeth, tongue and the inside of the mouth, the
  * skin's colours, and soft studio light: an environment map generated in code (three.js's RoomEnvironment through
  * PMREM: no download) plus a warm key, a cool fill and a rim light.
+ *
+ * Cost: the environment map is sampled only by the small wet surfaces that show its reflections (eyes, teeth,
+ * tongue); the skin, which covers most pixels, takes its soft light from a hemisphere light instead, is drawn from
+ * the front only (the head is closed), and has no sheen or clearcoat layer: together they made a frame about three
+ * times slower to shade (SwiftShader, npm run bench) for a difference hard to see at this size. The physical
+ * material's extras (a clear coat with the cornea's index of refraction) are kept for the eyes; the other surfaces use three.js's
+ * standard physically based material, whose fewer uniforms cost less main-thread time per draw.
  */
 import * as THREE from 'three';
 import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
@@ -9,45 +16,58 @@ import { lipMask, type FaceTemplate } from '../template/face-template';
 import { eyeTexture } from './eyes';
 
 export const BACKGROUND = 0x1d2230;
-export const SKIN = new THREE.Color(0xc4927a);
+export const SKIN = new THREE.Color(0xcc9c84);
 const CHEEK = new THREE.Color(0xc9766a);
-const LIP = new THREE.Color(0xa4504f);
+const LIP = new THREE.Color(0xa65b57);
 const HAIR = new THREE.Color(0x2b1d16);
 
-export function skinMaterial(): THREE.MeshPhysicalMaterial {
-  // Sheen stands in for light scattered under the skin: a warm glow at grazing angles.
-  return new THREE.MeshPhysicalMaterial({
-    name: 'skin', vertexColors: true, roughness: 0.58, metalness: 0, sheen: 0.35, sheenRoughness: 0.75,
-    sheenColor: new THREE.Color(0xff9a80), clearcoat: 0.06, clearcoatRoughness: 0.45, side: THREE.DoubleSide,
+export function skinMaterial(): THREE.MeshStandardMaterial {
+  // A little specular (oily skin) and a warm emissive floor for light scattered under the skin.
+  return new THREE.MeshStandardMaterial({
+    name: 'skin', vertexColors: true, roughness: 0.6, metalness: 0, emissive: 0x1c0804,
   });
 }
 
+/** Give the materials under `root` that reflect (eyes, teeth, tongue) the environment map. */
+function reflectEnvironment(root: THREE.Object3D, environment: THREE.Texture): void {
+  root.traverse((o) => {
+    if (!(o as THREE.Mesh).isMesh) return;
+    for (const m of ([] as THREE.Material[]).concat((o as THREE.Mesh).material)) {
+      if (m instanceof THREE.MeshStandardMaterial && REFLECTIVE.has(m.name)) {
+        m.envMap = environment;
+        m.needsUpdate = true;
+      }
+    }
+  });
+}
+const REFLECTIVE = new Set(['eye', 'teeth', 'tongue']);
+
 /** The inside of the mouth: dark, wet and reddish; seen from inside (its back faces). */
-export function cavityMaterial(): THREE.MeshPhysicalMaterial {
-  return new THREE.MeshPhysicalMaterial({ name: 'mouth', color: 0x2e0e12, roughness: 0.8, side: THREE.DoubleSide, envMapIntensity: 0.1 });
+export function cavityMaterial(): THREE.MeshStandardMaterial {
+  return new THREE.MeshStandardMaterial({ name: 'mouth', color: 0x2e0e12, roughness: 0.8, side: THREE.DoubleSide });
 }
 
-export function teethMaterial(): THREE.MeshPhysicalMaterial {
-  return new THREE.MeshPhysicalMaterial({ name: 'teeth', color: 0xeee6d6, roughness: 0.32, clearcoat: 0.5, clearcoatRoughness: 0.2, sheen: 0.2, sheenColor: new THREE.Color(0xfff4e0) });
+export function teethMaterial(): THREE.MeshStandardMaterial {
+  return new THREE.MeshStandardMaterial({ name: 'teeth', color: 0xeee6d6, roughness: 0.3, envMapIntensity: 0.5 });
 }
 
-export function tongueMaterial(): THREE.MeshPhysicalMaterial {
-  return new THREE.MeshPhysicalMaterial({ name: 'tongue', color: 0xb4565a, roughness: 0.45, clearcoat: 0.3, clearcoatRoughness: 0.3, sheen: 0.4, sheenColor: new THREE.Color(0xff8080) });
+export function tongueMaterial(): THREE.MeshStandardMaterial {
+  return new THREE.MeshStandardMaterial({ name: 'tongue', color: 0xa8484e, roughness: 0.6, envMapIntensity: 0.12 });
 }
 
-export function clothMaterial(): THREE.MeshPhysicalMaterial {
-  return new THREE.MeshPhysicalMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85, sheen: 0.6, sheenRoughness: 0.6, sheenColor: new THREE.Color(0x8898b8) });
+export function clothMaterial(): THREE.MeshStandardMaterial {
+  return new THREE.MeshStandardMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85 });
 }
 
-export function eyeMaterials(): { sclera: THREE.MeshPhysicalMaterial; cornea: THREE.MeshPhysicalMaterial } {
-  return {
-    sclera: new THREE.MeshPhysicalMaterial({ name: 'sclera', map: eyeTexture(), roughness: 0.35, clearcoat: 0.6, clearcoatRoughness: 0.1 }),
-    // Only the cornea's reflections are added: a black, glossy, additive shell shows highlights and nothing else.
-    cornea: new THREE.MeshPhysicalMaterial({
-      name: 'cornea', color: 0x000000, roughness: 0.04, metalness: 0, ior: 1.376, specularIntensity: 1, envMapIntensity: 2.5,
-      transparent: true, blending: THREE.AdditiveBlending, depthWrite: false,
-    }),
-  };
+/**
+ * The eyeball: the painted sclera, iris and pupil under a clear coat with the cornea's index of refraction, which
+ * catches the key light and the environment as the cornea's highlight (one draw per eye, not a second transparent
+ * cornea mesh: at this size the highlight is what shows of the cornea).
+ */
+export function eyeMaterial(): THREE.MeshPhysicalMaterial {
+  return new THREE.MeshPhysicalMaterial({
+    name: 'eye', map: eyeTexture(), roughness: 0.4, envMapIntensity: 0.6, clearcoat: 1, clearcoatRoughness: 0.03, ior: 1.376,
+  });
 }
 
 /**
@@ -85,25 +105,30 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
   return colors;
 }
 
-/** Soft light around a head: the generated environment, a warm key from above right, cool fill and rim. */
-export function lightScene(scene: THREE.Scene, renderer: THREE.WebGLRenderer): void {
+/**
+ * Soft light around the head already in `scene`: the generated environment (for the reflecting materials), a warm
+ * key from above right, a hemisphere's soft fill, cool fill and rim. Returns the environment texture (the caller
+ * disposes of it with the renderer it was made by).
+ */
+export function lightScene(scene: THREE.Scene, renderer: THREE.WebGLRenderer): THREE.Texture {
   const pmrem = new THREE.PMREMGenerator(renderer);
   const room = new RoomEnvironment();
-  scene.environment = pmrem.fromScene(room, 0.04).texture;
-  scene.environmentIntensity = 0.35;
+  const environment = pmrem.fromScene(room, 0.04).texture;
   room.dispose();
   pmrem.dispose();
+  reflectEnvironment(scene, environment);
   scene.background = new THREE.Color(BACKGROUND);
-  scene.add(new THREE.HemisphereLight(0xfff1e6, 0x3a3036, 0.35));
+  scene.add(new THREE.HemisphereLight(0xfff1e6, 0x4a3a3a, 0.9));
   const key = new THREE.DirectionalLight(0xfff0e0, 2.4);
   key.position.set(0.7, 0.9, 1.4);
   const fill = new THREE.DirectionalLight(0xc8d8ff, 0.5);
   fill.position.set(-1.2, 0.1, 0.9);
-  const rim = new THREE.DirectionalLight(0xaec4ff, 1.1);
+  const rim = new THREE.DirectionalLight(0xd8e2ff, 0.8);
   rim.position.set(-0.6, 0.7, -1.2);
   scene.add(key, fill, rim);
   renderer.toneMapping = THREE.NeutralToneMapping;
   renderer.toneMappingExposure = 0.95;
+  return environment;
 }
 
 /** A blue -> cyan -> green -> yellow -> red ramp at t in [0, 1], written to out[at..at+3) (painted maps). */

@@ -173,7 +173,7 @@ export function tongueGeometry(f: MouthFrame): THREE.BufferGeometry {
   const W = f.W;
   const g = new THREE.SphereGeometry(1, 28, 14);
   g.scale(0.4 * W, 0.16 * W, 0.62 * W);
-  const cy = f.lowerY - 0.15 * W, cz = f.frontZ - 0.72 * W;
+  const cy = f.lowerY - 0.19 * W, cz = f.frontZ - 0.72 * W;
   g.translate(f.center[0], cy, cz);
   const pos = g.getAttribute('position') as THREE.BufferAttribute;
   const raise = new Float32Array(pos.count * 3);

@@ -39,7 +39,7 @@ describe('mouthBag', () => {
     const f = mouthFrame(t);
     const g = tongueGeometry(f);
     const pos = g.getAttribute('position') as THREE.BufferAttribute;
-    const raise = g.morphAttributes.position[0] as THREE.BufferAttribute;
+    const raise = g.morphAttributes.position![0] as THREE.BufferAttribute;
     let tip = 0, back = 0;
     for (let i = 0; i < pos.count; i++) {
       if (pos.getZ(i) > f.frontZ - 0.2 * f.W) tip = Math.max(tip, raise.getY(i));
