@@ -247,6 +247,7 @@ export class TalkingFaceElement extends HTMLElement {
     if (this.live) {
       const live = this.live;
       this.live = null;
+      this.view?.setSpeaking(false); // back to the face at rest
       void live.stop().then(() => this.setStatus('Stopped listening.'));
     }
   }

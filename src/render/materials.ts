@@ -13,7 +13,6 @@
 import * as THREE from 'three';
 import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
 import { lipMask, type FaceTemplate } from '../template/face-template';
-import { eyeTexture } from './eyes';
 
 export const BACKGROUND = 0x1d2230;
 export const SKIN = new THREE.Color(0xcc9c84);
@@ -138,4 +137,42 @@ export function heat(t: number, out: Float32Array, at: number): void {
   const k = Math.min(stops.length - 2, Math.floor(x));
   const f = x - k;
   for (let i = 0; i < 3; i++) out[at + i] = stops[k][i] * (1 - f) + stops[k + 1][i] * f;
+}
+
+/**
+ * The eye's texture: the sphere's pole (top row) is the pupil's centre, rows go back over the ball by polar angle.
+ * Pupil, a radially streaked iris darkening to its limbus, and the sclera, faintly pink towards the back.
+ */
+/** Polar angles (degrees from the pupil's centre) of the pupil's and the iris's edges: an 11.7 mm iris on a 12 mm ball. */
+const PUPIL_EDGE = 11, IRIS_EDGE = 29.2;
+
+export function eyeTexture(): THREE.Texture {
+  const w = 256, h = 128;
+  const canvas = typeof document !== 'undefined' ? Object.assign(document.createElement('canvas'), { width: w, height: h }) : new OffscreenCanvas(w, h);
+  const ctx = canvas.getContext('2d') as CanvasRenderingContext2D;
+  const image = ctx.createImageData(w, h);
+  const deg = (row: number) => ((row + 0.5) / h) * 180; // polar angle from the pupil's centre
+  for (let y = 0; y < h; y++) {
+    const a = deg(y);
+    for (let x = 0; x < w; x++) {
+      const streak = 0.5 + 0.5 * Math.sin(x * 0.9) * Math.sin(x * 0.37 + 1.3);
+      let c: number[];
+      if (a < PUPIL_EDGE) c = [8, 6, 6];
+      else if (a < IRIS_EDGE) {
+        const t = (a - PUPIL_EDGE) / (IRIS_EDGE - PUPIL_EDGE);
+        const base = [70 + 48 * t, 52 + 40 * t, 34 + 20 * t]; // brown, lighter outwards
+        c = base.map((v) => v * (0.7 + 0.5 * streak) * (a > IRIS_EDGE - 3.5 ? 0.55 : 1)); // the limbus
+      } else {
+        const t = Math.min(1, (a - IRIS_EDGE) / 70);
+        c = [236 - 8 * t, 232 - 28 * t, 226 - 34 * t];
+      }
+      const i = 4 * (y * w + x);
+      image.data.set([c[0], c[1], c[2], 255], i);
+    }
+  }
+  ctx.putImageData(image, 0, 0);
+  const texture = new THREE.CanvasTexture(canvas as HTMLCanvasElement);
+  texture.colorSpace = THREE.SRGBColorSpace;
+  texture.anisotropy = 4;
+  return texture;
 }

@@ -110,3 +110,26 @@ test('an open vowel shows the inside of the mouth, with no background pixel insi
   expect(result.pixels, 'the open mouth covers some pixels').toBeGreaterThan(40);
   expect(result.background, 'background pixels inside the lips').toBe(0);
 });
+
+test('after speech the face blends back to its rest, mouth closed', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
+  await page.locator('#sample-select').selectOption(first!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  const weight = () => page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.view.speechWeight);
+  await expect.poll(weight).toBe(1); // a take's frame is shown
+  await page.locator('#play-button').click();
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+  await expect(page.locator('#play-button')).toHaveText('Play', { timeout: 30_000 }); // the end of the take
+  await expect.poll(weight, { timeout: 5_000 }).toBe(0);
+  const gapMm = await page.evaluate(() => {
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace, r = tf.template.regions, p = tf.view.shownVertices;
+    const up = Array.from(r.lips_inner_upper).filter((v) => !r.lips_inner_lower.includes(v));
+    const lo = Array.from(r.lips_inner_lower).filter((v) => !r.lips_inner_upper.includes(v));
+    const meanY = (vs: number[]) => vs.reduce((s, v) => s + p[3 * v + 1], 0) / vs.length;
+    return (meanY(up) - meanY(lo)) / tf.engine.unitsPerMm;
+  });
+  expect(gapMm, 'inner-lip gap after speech (mm)').toBeLessThan(1);
+});
