@@ -145,7 +145,11 @@ export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: nu
     duration: gltf.animations[0]?.duration ?? 0,
     vertices: m?.geometry.getAttribute('position').count ?? 0,
     parts,
-    animated: [...new Set((gltf.animations[0]?.tracks ?? []).map((t) => t.name.split('.')[0]))],
+    // The face's two primitives (skin, mouth) load as child meshes of the 'face' node, each with its morph track.
+    animated: [...new Set((gltf.animations[0]?.tracks ?? []).map((t) => {
+      const node = gltf.scene.getObjectByName(t.name.split('.')[0]);
+      return node?.parent?.name === 'face' ? 'face' : t.name.split('.')[0];
+    }))],
   };
 }
 
