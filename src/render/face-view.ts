@@ -57,6 +57,7 @@ export class FaceView {
   private frameHandle = 0;
   private lastTime = -1;
   private readonly faceRadius: number;
+  private readonly frameSize: { height: number; width: number };
   private readonly environment: THREE.Texture;
   private readonly bodyHeight: number;
   private arrows: { template: THREE.ArrowHelper; current: THREE.ArrowHelper } | null = null;
@@ -81,7 +82,9 @@ export class FaceView {
     const m = this.model.measures;
     const H = m.top - m.chin;
     const crown = this.model.shell ? this.model.shell.egg.center[1] + this.model.shell.egg.up : m.top;
-    const target = new THREE.Vector3(m.centerX, (crown + m.chin) / 2 - 0.12 * H, m.sideZ + 0.3 * m.halfWidth);
+    const target = new THREE.Vector3(m.centerX, (crown + m.chin) / 2 - 0.02 * H, m.sideZ + 0.3 * m.halfWidth);
+    // What the camera frames: the head from crown to chin with a margin, and a little more than its width.
+    this.frameSize = { height: 1.12 * (crown - m.chin), width: 2.5 * m.halfWidth };
     const face = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(template.positions, 3));
     face.computeBoundingSphere();
     this.faceRadius = face.boundingSphere!.radius;
@@ -282,12 +285,18 @@ export class FaceView {
     this.renderer.render(this.scene, this.camera);
   };
 
+  /** Fit the head in the canvas (a new size resets the zoom, not the direction the camera looks from). */
   private resize(): void {
     const w = Math.max(1, this.canvas.clientWidth);
     const h = Math.max(1, this.canvas.clientHeight);
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
+    const tan = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2));
+    const distance = Math.max(this.frameSize.height / (2 * tan), this.frameSize.width / (2 * tan * this.camera.aspect));
+    const t = this.controls.target;
+    this.camera.position.sub(t).setLength(distance).add(t);
+    this.controls.update();
     this.requestRender();
   }
 }
