@@ -18,7 +18,7 @@ async function ready(page: Page, attr: string, value: string): Promise<void> {
   await page.waitForSelector(`body[data-${attr}="${value}"]`, { timeout: 120_000 });
 }
 
-/** Orbit the demo's camera to `azimuth` (radians, 0 = front) at `distance` times its current distance; aim at y. */
+/** Put the demo's camera at `azimuth` (radians about the target, 0 = front) at `distance` times its current distance; aim at y. */
 async function orbit(page: Page, azimuth: number, distance: number, aimY?: number): Promise<void> {
   await page.evaluate(`(() => {
     const v = globalThis.talkingFace.view;
@@ -43,9 +43,8 @@ async function headViews(browser: Browser): Promise<void> {
   await canvas.screenshot({ path: resolve(OUT, 'head-front.png') });
   await orbit(page, 0.7, 1);
   await canvas.screenshot({ path: resolve(OUT, 'head-three-quarter.png') });
-  await orbit(page, Math.PI / 2 - 0.7, 1);
+  await orbit(page, Math.PI / 2, 1);
   await canvas.screenshot({ path: resolve(OUT, 'head-profile.png') });
-  await orbit(page, -Math.PI / 2, 1);
   const sample = (await page.locator('#sample-select option').nth(1).getAttribute('value'))!;
   await page.locator('#sample-select').selectOption(sample);
   await ready(page, 'take', 'ready');
