@@ -9,6 +9,7 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
 import { requestSharedDevice, detectWebGPU } from '../src/gpu/capabilities';
 import { buildAdjacency } from '../src/template/mesh-topology';
+import { renderBench } from './render-bench';
 
 const now = () => performance.now();
 const heap = () => (performance as unknown as { memory?: { usedJSHeapSize: number } }).memory?.usedJSHeapSize ?? 0;
@@ -31,7 +32,7 @@ function gridAdjacency(rows: number, cols: number, extra: number) {
   return buildAdjacency(rows * cols + extra, Uint32Array.from(tris));
 }
 
-async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: number[]): Promise<Record<string, unknown>> {
+async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: number[], renderOnly: boolean): Promise<Record<string, unknown>> {
   const result: Record<string, unknown> = { userAgent: navigator.userAgent, crossOriginIsolated };
   const gpu = await detectWebGPU();
   result.adapter = gpu.info;
@@ -39,12 +40,15 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   let t = now();
   const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
   result.model_load_ms = now() - t;
+  const rate = engine.manifest.audio.sample_rate;
+  const wav = await decodeAudio(wavBytes, rate);
+  // The head on screen (dev/render-bench.ts): 3 s of speech drawn frame by frame.
+  result.render = await renderBench(engine, speechOf(3, wav.samples, rate));
+  if (renderOnly) return result;
   result.cpu_decoder_threads = engine.cpuThreads;
   result.cpu_decoder_kernel = engine.cpuKernel;
   const bytes = await Promise.all(engine.manifest.runtime_files.map(async (k) => (await fetch(`/models/${engine.manifest.files[k]}`)).arrayBuffer()));
   result.model_bytes = bytes.reduce((s, b) => s + b.byteLength, 0);
-  const rate = engine.manifest.audio.sample_rate;
-  const wav = await decodeAudio(wavBytes, rate);
 
   const stages: Record<string, unknown> = {};
   for (const backend of backends) {
@@ -141,10 +145,10 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
 
 /** Called by scripts/bench.ts with a speech recording (base64 WAV). */
 Object.assign(globalThis, {
-  runBench: async (wavBase64: string, backends: Backend[], seconds: number[]) => {
+  runBench: async (wavBase64: string, backends: Backend[], seconds: number[], renderOnly = false) => {
     const bytes = Uint8Array.from(atob(wavBase64), (c) => c.charCodeAt(0));
     try {
-      return await run(bytes.buffer, backends, seconds);
+      return await run(bytes.buffer, backends, seconds, renderOnly);
     } catch (e) {
       return { error: (e as Error).message, stack: (e as Error).stack };
     }

@@ -4,6 +4,9 @@
  * WebGPU here is SwiftShader (software): its figures are reported, not GPU figures.
  *
  *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]
+ *   npm run bench -- --render-only    # only the head's render benchmark, merged into the existing bench.json
+ *
+ * BENCH_PORT sets the preview server's port (default 4191), for several checkouts benchmarking at once.
  */
 import { chromium } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
@@ -26,7 +29,8 @@ const opt = (name: string, fallback: string) => {
 };
 const seconds = opt('--seconds', '10,60').split(',').map(Number);
 const backends = opt('--backends', 'cpu,webgpu').split(',');
-const PORT = 4191;
+const PORT = Number(process.env.BENCH_PORT ?? 4191);
+const renderOnly = args.includes('--render-only');
 
 /** The parts of the engine that run the same in Node (no Web Audio, no WebGPU): Mel and the CPU decoders. */
 async function nodeBench(): Promise<Record<string, number | string>> {
@@ -90,11 +94,20 @@ async function main(): Promise<void> {
     const wav = readFileSync(resolve(ROOT, 'tests/fixtures/speech-kal.wav')).toString('base64');
     const t0 = Date.now();
     const result = (await page.evaluate(
-      ([w, b, s]) => (globalThis as unknown as { runBench: (w: string, b: string[], s: number[]) => Promise<Record<string, unknown>> }).runBench(w, b, s),
-      [wav, backends, seconds] as const,
+      ([w, b, s, r]) => (globalThis as unknown as { runBench: (w: string, b: string[], s: number[], r: boolean) => Promise<Record<string, unknown>> }).runBench(w, b, s, r),
+      [wav, backends, seconds, renderOnly] as const,
     )) as Record<string, unknown>;
     await browser.close();
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
+    if (renderOnly) {
+      // Keep the engine's figures of the last full run; replace only the render benchmark's.
+      const file = resolve(ROOT, 'docs/results/bench.json');
+      const previous = JSON.parse(readFileSync(file, 'utf8')) as Record<string, unknown>;
+      writeFileSync(file, JSON.stringify({ ...previous, render: result.render }, null, 1) + '\n');
+      printRender(result.render as Record<string, number>);
+      console.log('written: docs/results/bench.json (render only)');
+      return;
+    }
     result.node = node;
     result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
     mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
@@ -126,7 +139,16 @@ function print(r: Record<string, unknown>): void {
   const nd = r.node as Record<string, number> & { decoder_kernel: string };
   console.log(`Node: Mel ${f(nd.mel_ms_per_audio_second)} ms per audio second (Meyda.extract per frame: ${f(nd.mel_meyda_extract_ms_per_audio_second)}); ` +
     `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel} (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
+  printRender(r.render as Record<string, number>);
   console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
+}
+
+/** The head's render benchmark (dev/render-bench.ts): per frame, the main thread's work and the whole frame. */
+function printRender(v: Record<string, number>): void {
+  const f = (x: number) => x.toFixed(2);
+  console.log(`render (${v.width}x${v.height}, ${v.skin_vertices} skin vertices, ${v.triangles} triangles, ${v.draw_calls} draw calls): ` +
+    `main thread ${f(v.main_thread_ms)} ms per frame (head update ${f(v.head_update_ms)}, of which the extra geometry ${f(v.extra_geometry_ms)}; ` +
+    `render call ${f(v.render_call_ms)}); whole frame with SwiftShader's software rendering ${f(v.frame_ms)} ms`);
 }
 
 main().catch((e) => {

@@ -1,8 +1,9 @@
 /**
  * npm run screenshots: the demo's main views, rendered in headless Chromium (SwiftShader WebGL), saved
- * to docs/screenshots/. Builds the app and serves it like the tests do.
+ * to docs/screenshots/. Builds the app and serves it like the tests do (SCREENSHOTS_PORT, default 4192).
+ * The head: front, three-quarter and profile at rest, the mouth open on a vowel, the lips closed on /m/, idle.
  */
-import { chromium, type Page } from '@playwright/test';
+import { chromium, type Browser, type Page } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
 import { mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
@@ -10,11 +11,67 @@ import { fakeMicrophone } from '../playwright.config';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const OUT = resolve(ROOT, 'docs/screenshots');
-const PORT = 4192;
+const PORT = Number(process.env.SCREENSHOTS_PORT ?? 4192);
 const URL_ = `http://127.0.0.1:${PORT}`;
 
 async function ready(page: Page, attr: string, value: string): Promise<void> {
   await page.waitForSelector(`body[data-${attr}="${value}"]`, { timeout: 120_000 });
+}
+
+/** Put the demo's camera at `azimuth` (radians about the target, 0 = front) at `distance` times its current distance; aim at y. */
+async function orbit(page: Page, azimuth: number, distance: number, aimY?: number): Promise<void> {
+  await page.evaluate(`(() => {
+    const v = globalThis.talkingFace.view;
+    const t = v.controls.target, c = v.camera.position;
+    if (${aimY ?? 'null'} !== null) t.y = ${aimY ?? 0};
+    const d = c.distanceTo(t) * ${distance};
+    c.set(t.x + d * Math.sin(${azimuth}), t.y + d * 0.04, t.z + d * Math.cos(${azimuth}));
+    v.controls.update();
+    v.requestRender();
+  })()`);
+  await page.waitForTimeout(500);
+}
+
+/** The whole head: three angles at rest, idle, an open vowel and a closure on /m/ (a sample clip's frames). */
+async function headViews(browser: Browser): Promise<void> {
+  const page = await browser.newPage({ viewport: { width: 760, height: 980 } });
+  await page.goto(`${URL_}/`);
+  await ready(page, 'rest', 'shown');
+  await page.waitForTimeout(1500);
+  await page.screenshot({ path: resolve(OUT, 'idle.png') });
+  const canvas = page.locator('#face-canvas');
+  await canvas.screenshot({ path: resolve(OUT, 'head-front.png') });
+  await orbit(page, 0.7, 1);
+  await canvas.screenshot({ path: resolve(OUT, 'head-three-quarter.png') });
+  await orbit(page, Math.PI / 2, 1);
+  await canvas.screenshot({ path: resolve(OUT, 'head-profile.png') });
+  const sample = (await page.locator('#sample-select option').nth(1).getAttribute('value'))!;
+  await page.locator('#sample-select').selectOption(sample);
+  await ready(page, 'take', 'ready');
+  // The widest-open frame heard as a vowel, and the most closed frame heard as /m/.
+  const frames = (await page.evaluate(`(() => {
+    const tf = globalThis.talkingFace, a = tf.take.animation, r = tf.template.regions, names = tf.engine.manifest.content_phones;
+    const n3 = a.unposed.length / a.frames;
+    const up = Array.from(r.lips_inner_upper).filter((v) => !r.lips_inner_lower.includes(v));
+    const lo = Array.from(r.lips_inner_lower).filter((v) => !r.lips_inner_upper.includes(v));
+    const gap = (f) => up.reduce((s, v) => s + a.unposed[f * n3 + 3 * v + 1], 0) / up.length - lo.reduce((s, v) => s + a.unposed[f * n3 + 3 * v + 1], 0) / lo.length;
+    let vowel = 0, m = -1;
+    for (let f = 0; f < a.frames; f++) {
+      const p = names[a.phones[f]];
+      if (/^(AA|AE|AH|AO|AW|AY|EH|ER|EY|IH|IY|OW|OY|UH|UW)$/.test(p) && gap(f) > gap(vowel)) vowel = f;
+      if (p === 'M' && (m < 0 || gap(f) < gap(m))) m = f;
+    }
+    return { vowel, m };
+  })()`)) as { vowel: number; m: number };
+  const mouthY = await page.evaluate(`(() => { const t = globalThis.talkingFace.template, r = t.regions.lips_outer; return Array.from(r).reduce((s, v) => s + t.positions[3 * v + 1], 0) / r.length; })()`) as number;
+  await orbit(page, 0.25, 0.45, mouthY);
+  for (const [name, frame] of [['mouth-vowel.png', frames.vowel], ['mouth-m.png', frames.m]] as const) {
+    if (frame < 0) throw new Error(`the sample clip has no frame for ${name}`);
+    await page.locator('#scrub').fill(String(frame));
+    await page.waitForTimeout(800); // the speech blend
+    await canvas.screenshot({ path: resolve(OUT, name) });
+  }
+  await page.close();
 }
 
 async function main(): Promise<void> {
@@ -32,6 +89,7 @@ async function main(): Promise<void> {
     }
     const wav = resolve(ROOT, 'tests/fixtures/speech-kal.wav');
     const browser = await chromium.launch(fakeMicrophone(wav));
+    await headViews(browser);
     const page = await browser.newPage({ viewport: { width: 1100, height: 760 } });
     await page.goto(`${URL_}/`);
     await ready(page, 'engine', 'ready');

@@ -1,6 +1,9 @@
 /**
- * Export an animation as binary glTF (.glb) that standard viewers play, with the head pose as the
- * node's rotation and translation and the facial motion as morph targets, in one of two encodings:
+ * Export an animation as binary glTF (.glb) that standard viewers play: the whole head (render/head.ts: face,
+ * skull and neck, eyes, teeth, tongue, the mouth's inside), with the head pose as the head node's rotation and
+ * translation, the lower jaw's rotation (estimated from the face, render/jaw.ts), the tongue's raise and the eyes'
+ * gaze as tracks, and the motion of the face (with the shell and mouth that follow it) as morph targets, in one of
+ * two encodings:
  * - up to GLB_EXACT_FRAMES frames, exact: the neutral face as the mesh, one morph target per frame
  *   (that frame's I + O minus I) and a weights track that steps through them (one target on at a time);
  * - longer clips, compact: the mean face as the mesh and GLB_COMPONENTS morph targets, the strongest
@@ -14,6 +17,8 @@ import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
 import { motionBasis } from './motion-basis';
+import { Head } from '../render/head';
+import { IdleMotion } from '../render/idle-motion';
 
 /** Longest clip exported with one morph target per frame (its weights track is frames x frames). */
 export const GLB_EXACT_FRAMES = 1800;
@@ -33,43 +38,52 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   if (!animation.unposed) throw new Error('exportGlb: the animation has no unposed frames');
   const frames = animation.frames;
   if (frames < 1) throw new Error('exportGlb: the animation has no frames');
-  const n = template.vertexCount;
-  const dims = n * 3;
-  const geometry = new THREE.BufferGeometry();
+  // The whole head (render/head.ts): face + shell + mouth cavity in one buffer, posed frame by frame like the view.
+  const head = new Head(template);
+  const base = head.vertices.slice();
+  const dims = base.length;
+  const n3 = template.vertexCount * 3;
+  const D = new Float32Array(frames * dims); // per frame: the joined buffer minus its template pose
+  const jaw = new Float32Array(frames * 4);
+  const tongue = new Float32Array(frames);
+  const q = new THREE.Quaternion();
+  for (let f = 0; f < frames; f++) {
+    head.setFace(animation.unposed.subarray(f * n3, (f + 1) * n3), animation.tongue[f] ?? 0);
+    const v = head.vertices;
+    for (let i = 0; i < dims; i++) D[f * dims + i] = v[i] - base[i];
+    head.jaw.quaternion.toArray(jaw, f * 4);
+    tongue[f] = animation.tongue[f] ?? 0;
+  }
+  const geometry = head.skin.geometry;
   const targets: THREE.BufferAttribute[] = [];
   let weights: Float32Array;
   let maxErrorMm = 0;
   const exact = frames <= GLB_EXACT_FRAMES;
-  const D = new Float32Array(frames * dims); // per frame: I + O minus I
-  for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) D[f * dims + i] = animation.unposed[f * dims + i] - template.positions[i];
   if (exact) {
-    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(template.positions), 3));
+    geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
     for (let f = 0; f < frames; f++) targets.push(new THREE.BufferAttribute(D.subarray(f * dims, (f + 1) * dims), 3));
     weights = new Float32Array(frames * frames);
     for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   } else {
     const m = motionBasis(D, frames, dims, GLB_COMPONENTS);
-    const base = new Float32Array(dims);
-    for (let i = 0; i < dims; i++) base[i] = template.positions[i] + m.mean[i];
-    geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
+    const mean = new Float32Array(dims);
+    for (let i = 0; i < dims; i++) mean[i] = base[i] + m.mean[i];
+    geometry.setAttribute('position', new THREE.BufferAttribute(mean, 3));
     for (let k = 0; k < m.components; k++) targets.push(new THREE.BufferAttribute(m.basis.subarray(k * dims, (k + 1) * dims), 3));
     weights = m.coefficients;
     maxErrorMm = m.maxError / unitsPerMm;
   }
-  geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
   geometry.morphAttributes.position = targets;
   geometry.morphTargetsRelative = true;
   geometry.computeVertexNormals();
-  const mesh = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({ color: 0xe0ac8e, roughness: 0.6, side: THREE.DoubleSide }));
-  mesh.name = name;
-  mesh.updateMorphTargets();
+  head.skin.updateMorphTargets();
+  head.group.name = name;
   const scene = new THREE.Scene();
-  scene.add(mesh);
+  scene.add(head.group, head.body);
 
   const times = Float32Array.from({ length: frames }, (_, f) => f / animation.fps);
   const quats = new Float32Array(frames * 4);
   const moves = new Float32Array(frames * 3);
-  const q = new THREE.Quaternion();
   const axis = new THREE.Vector3();
   for (let f = 0; f < frames; f++) {
     const p = animation.pose.subarray(f * 6, f * 6 + 6);
@@ -80,30 +94,62 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
     moves.set([p[3] * unitsPerMm, p[4] * unitsPerMm, p[5] * unitsPerMm], f * 3);
   }
   const clip = new THREE.AnimationClip('speech', Math.max(frames - 1, 0) / animation.fps, [
-    new THREE.NumberKeyframeTrack(`${name}.morphTargetInfluences`, times, weights),
+    new THREE.NumberKeyframeTrack('face.morphTargetInfluences', times, weights),
     new THREE.QuaternionKeyframeTrack(`${name}.quaternion`, times, quats),
     new THREE.VectorKeyframeTrack(`${name}.position`, times, moves),
+    new THREE.QuaternionKeyframeTrack('jaw_lower.quaternion', times, jaw),
+    new THREE.NumberKeyframeTrack('tongue.morphTargetInfluences', times, tongue),
+    ...gazeTracks(head, times),
   ]);
   const bytes = (await new GLTFExporter().parseAsync(scene, { binary: true, animations: [clip] })) as ArrayBuffer;
-  geometry.dispose();
-  (mesh.material as THREE.Material).dispose();
+  head.dispose();
   return { bytes, frames, encoding: exact ? 'per-frame' : 'components', morphTargets: targets.length, maxErrorMm };
 }
 
-/** Re-load a .glb with three.js: how many morph targets, animation clips and their duration. */
-export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number }> {
+/** The eyes' gaze per frame: on the viewer straight ahead, with the idle schedule's saccades and glances (idle-motion.ts). */
+function gazeTracks(head: Head, times: Float32Array): THREE.KeyframeTrack[] {
+  const idle = new IdleMotion(1);
+  const ahead = new THREE.Vector3();
+  const far = head.measures.top - head.measures.chin; // a viewer in front, far compared with the eyes' spacing
+  const tracks: THREE.KeyframeTrack[] = [];
+  const per = [new Float32Array(times.length * 4), new Float32Array(times.length * 4)];
+  times.forEach((t, f) => {
+    const s = idle.at(t);
+    const eyes = head.eyes;
+    ahead.set(eyes.centers[0].x / 2 + eyes.centers[1].x / 2, eyes.centers[0].y, eyes.centers[0].z + 10 * far);
+    eyes.lookAt(ahead, s.yaw, s.pitch);
+    eyes.left.quaternion.toArray(per[0], f * 4);
+    eyes.right.quaternion.toArray(per[1], f * 4);
+  });
+  tracks.push(new THREE.QuaternionKeyframeTrack('eye_left.quaternion', times, per[0]), new THREE.QuaternionKeyframeTrack('eye_right.quaternion', times, per[1]));
+  return tracks;
+}
+
+/**
+ * Re-load a .glb with three.js: the face mesh's morph targets and vertices, the animation clips, their duration,
+ * the names of the head's parts, and which of them the clip animates.
+ */
+export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[] }> {
   const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
   const gltf = await new GLTFLoader().parseAsync(bytes, '');
-  let mesh: THREE.Mesh | null = null;
+  let face: THREE.Mesh | null = null;
+  const parts: string[] = [];
   gltf.scene.traverse((o) => {
-    if (!mesh && (o as THREE.Mesh).isMesh) mesh = o as THREE.Mesh;
+    if (o.name) parts.push(o.name);
+    if (!face && (o as THREE.Mesh).isMesh && (o as THREE.Mesh).geometry.morphAttributes.position?.length) face = o as THREE.Mesh;
   });
-  const m = mesh as THREE.Mesh | null;
+  const m = face as THREE.Mesh | null;
   return {
     morphTargets: m?.geometry.morphAttributes.position?.length ?? 0,
     clips: gltf.animations.length,
     duration: gltf.animations[0]?.duration ?? 0,
     vertices: m?.geometry.getAttribute('position').count ?? 0,
+    parts,
+    // The face's two primitives (skin, mouth) load as child meshes of the 'face' node, each with its morph track.
+    animated: [...new Set((gltf.animations[0]?.tracks ?? []).map((t) => {
+      const node = gltf.scene.getObjectByName(t.name.split('.')[0]);
+      return node?.parent?.name === 'face' ? 'face' : t.name.split('.')[0];
+    }))],
   };
 }
 

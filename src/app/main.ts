@@ -70,7 +70,7 @@ async function start(): Promise<void> {
     void loadSamples();
     engine.restFace().then(
       (rest) => {
-        if (!take) view.setVertices(rest); // the mouth closed at rest, not the opened template
+        view.setRestFace(rest); // the mouth closed at rest, not the opened template
         document.body.dataset.rest = 'shown';
       },
       (err: Error) => showStatus(`The face at rest could not be computed: ${err.message}`, true),

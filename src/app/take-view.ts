@@ -107,7 +107,7 @@ export class TakeView {
   setSideBySide(on: boolean, take: Take | null): void {
     ui.gtView.hidden = !on;
     if (on && !this.truthView) {
-      this.truthView = new FaceView(ui.gtCanvas, this.view.template);
+      this.truthView = new FaceView(ui.gtCanvas, this.view.template, { life: false }); // the truth exactly as recorded
       this.truthView.showPoseArrows(ui.arrowsCheck.checked);
     }
     if (on && !take?.truth) showLegend('Side by side needs a sample clip (it has ground truth).');

@@ -17,7 +17,7 @@ import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
-import { Player, audioNotes } from '../player/player';
+import { Player, audioNotes, type PlayerView } from '../player/player';
 import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -234,6 +234,7 @@ export class TalkingFaceElement extends HTMLElement {
     if (this.live) {
       const live = this.live;
       this.live = null;
+      (this.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
       void live.stop().then(() => this.setStatus('Stopped listening.'));
     }
   }
@@ -279,7 +280,7 @@ export class TalkingFaceElement extends HTMLElement {
       this.player = new Player(view, engine.unitsPerMm, { onFrame: (f) => this.playbackFrame(f), onEnded: () => this.dispatchEvent(new CustomEvent('ended')) });
     }
     engine.restFace().then(
-      (rest) => { if (!this.animation) this.view?.setVertices(rest); }, // the mouth closed at rest, not the opened template
+      (rest) => (this.view as PlayerView | null)?.setRestFace?.(rest), // the mouth closed at rest, not the opened template; idle life starts from it
       (e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`),
     );
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);

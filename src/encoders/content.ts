@@ -15,8 +15,16 @@ export interface ContentRange {
   melHi: number;
 }
 
+/**
+ * The phones that raise the tongue's tip to the ridge behind the upper teeth (ARPAbet: /t d n l/ and the dental
+ * fricatives /th/ (TH) and /dh/ (DH)). Their posteriors, summed, say how raised the tongue is at a frame.
+ */
+export const TONGUE_RAISING_PHONES = ['T', 'D', 'N', 'L', 'TH', 'DH'];
+
 export class ContentEncoder {
   private readonly m: ModelConstants;
+  /** Indices of TONGUE_RAISING_PHONES among manifest.content_phones (names the manifest lacks are skipped). */
+  private readonly tongueClasses: number[];
 
   private constructor(
     private readonly manifest: Manifest,
@@ -24,6 +32,7 @@ export class ContentEncoder {
     private readonly hierarchical: OnnxModel,
   ) {
     this.m = manifest.model.config;
+    this.tongueClasses = TONGUE_RAISING_PHONES.map((p) => manifest.content_phones.indexOf(p)).filter((k) => k >= 0);
   }
 
   static async create(manifest: Manifest, files: Record<string, ArrayBuffer>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
@@ -95,6 +104,20 @@ export class ContentEncoder {
       out.set(post.subarray(row, row + classes), i * classes);
     });
     return out;
+  }
+
+  /**
+   * How raised the tongue is at each frame, 0..1: the summed posteriors of TONGUE_RAISING_PHONES at the frame's
+   * content position (what a renderer draws the tongue from; the face model itself does not move a tongue).
+   */
+  tongueRaise(post: Float32Array, melIndex: number[], r: ContentRange): Float32Array {
+    const { content_stride: stride, content_classes: classes } = this.m;
+    return Float32Array.from(melIndex, (k) => {
+      const row = (Math.floor(k / stride) - r.lo) * classes;
+      let s = 0;
+      for (const j of this.tongueClasses) s += post[row + j];
+      return Math.min(1, s);
+    });
   }
 
   /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */

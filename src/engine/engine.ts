@@ -177,6 +177,7 @@ export class TalkingFaceEngine {
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
     const phones = new Uint8Array(F);
     const blendshapes = options.blendshapes ? emptyBlendshapes(F) : undefined;
+    const tongue = new Float32Array(F);
     const state = this.pipeline.newState({ blendshapes: options.blendshapes });
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
@@ -188,10 +189,11 @@ export class TalkingFaceEngine {
       unposed?.set(out.unposed, f0 * n * 3);
       phones.set(out.phones, f0);
       if (blendshapes) setBlendshapes(blendshapes, out.blendshapes!, f0);
+      tongue.set(out.tongue, f0);
       options.onFrames?.(f0, out.vertices, out.pose, out);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, blendshapes };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue, blendshapes };
   }
 
   /**

@@ -13,6 +13,8 @@ export interface Frames {
   pose: Float32Array;
   /** (count): the content class heard most at each frame (manifest.content_phones). */
   phones: Uint8Array;
+  /** (count): how raised the tongue is, 0..1 (the posteriors of /t d n l th dh/ summed; encoders/content.ts). */
+  tongue: Float32Array;
   /** ARKit weights, visemes and head rotation per frame, when the stream was created with `blendshapes: true`. */
   blendshapes?: BlendshapeFrames;
 }
@@ -28,6 +30,8 @@ export interface Animation {
   unposed?: Float32Array;
   /** (frames): the content class the encoder heard most at each frame (names: manifest.content_phones). */
   phones: Uint8Array;
+  /** (frames): how raised the tongue is, 0..1 (the posteriors of /t d n l th dh/ summed; encoders/content.ts). */
+  tongue: Float32Array;
   /** Per frame: 52 ARKit weights, 15 visemes, head yaw / pitch / roll (animate with `blendshapes: true`). */
   blendshapes?: BlendshapeFrames;
 }
@@ -53,6 +57,7 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
   const pose = new Float32Array(count * 6);
   const phones = new Uint8Array(count);
   const blendshapes = chunks.every((f) => f.blendshapes) && count > 0 ? emptyBlendshapes(count) : undefined;
+  const tongue = new Float32Array(count);
   let i = 0;
   for (const f of chunks) {
     vertices.set(f.vertices, i * per);
@@ -60,9 +65,10 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
     pose.set(f.pose, i * 6);
     phones.set(f.phones, i);
     if (blendshapes) setBlendshapes(blendshapes, f.blendshapes!, i);
+    tongue.set(f.tongue, i);
     i += f.count;
   }
-  return { fps, frames: count, vertices, pose, unposed, phones, blendshapes };
+  return { fps, frames: count, vertices, pose, unposed, phones, tongue, blendshapes };
 }
 
 /** Room for `frames` frames of blendshape output. */

@@ -107,6 +107,7 @@ export class Pipeline {
     const post = await this.content.posteriors(mel, range);
     const windows = this.content.windows(post, melIndex, range, K);
     const phones = this.content.heardPhones(post, melIndex, range);
+    const tongue = this.content.tongueRaise(post, melIndex, range);
     this.times.content += performance.now() - t;
 
     t = performance.now();
@@ -138,7 +139,7 @@ export class Pipeline {
     }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
-    const frames: Frames = { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+    const frames: Frames = { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones, tongue };
     if (state.blendshapes) {
       t = performance.now();
       const posteriors = this.content.framePosteriors(post, melIndex, range);

@@ -15,6 +15,12 @@ export interface PlayerView {
   setPose(rx: number, ry: number, rz: number, tx: number, ty: number, tz: number): void;
   /** Frame `frame` of the take's (or stream's) ARKit weights, visemes and head rotation, when it carries them. */
   setBlendshapes?(blendshapes: BlendshapeFrames, frame: number): void;
+  /** How raised the tongue is, 0..1 (a view that draws one). */
+  setTongue?(raise: number): void;
+  /** Speech is shown (true) or the face returns to rest (false), for a view with idle life. */
+  setSpeaking?(on: boolean): void;
+  /** The model's face at rest, for a view with idle life. */
+  setRestFace?(rest: Float32Array): void;
 }
 
 /** Longer clips get a note with the expected time (they still work: memory stays bounded). */
@@ -90,7 +96,9 @@ export class Player {
     const f = Math.min(Math.max(0, Math.floor(frame)), a.frames - 1);
     this.currentFrame = f;
     const unposed = a.unposed.subarray(f * n3, (f + 1) * n3);
+    this.view.setTongue?.(a.tongue[f] ?? 0);
     this.view.setVertices(this.shape ? this.shape(f, unposed) : unposed);
+    this.view.setSpeaking?.(true);
     if (a.blendshapes) this.view.setBlendshapes?.(a.blendshapes, f);
     this.pose(a.pose.subarray(f * 6, f * 6 + 6));
     this.options.onFrame?.(f);
@@ -100,7 +108,9 @@ export class Player {
   showLive(frames: Frames): void {
     const last = frames.count - 1;
     const n3 = frames.unposed.length / frames.count;
+    this.view.setTongue?.(frames.tongue[last] ?? 0);
     this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
+    this.view.setSpeaking?.(true);
     if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, last);
     this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
   }
@@ -138,6 +148,7 @@ export class Player {
           return;
         }
         this.show(a.frames - 1);
+        this.view.setSpeaking?.(false); // after speech, back to the face at rest
         resolve();
         this.options.onEnded?.();
       };

@@ -1,78 +1,97 @@
 /**
- * Draws a face template (and later, posed frames y_i = T_p,i (I + O_i)) with three.js:
- * a shaded skin surface, two eyeballs behind the lid openings and a dark
- * inner-mouth backing so parted lips never show the void behind the mask.
+ * Draws a face template as a whole head (head.ts: the face the model animates inside a generated skull and neck,
+ * eyes, teeth, tongue, a mouth) with three.js, and keeps it alive: between words it shows the model's rest face,
+ * breathes, blinks and moves its eyes (idle-motion.ts); speech blends in and out of that rest without a pop.
  *
- * The caller owns the canvas. `setVertices` updates the position attribute in
- * place; nothing is allocated per frame.
+ * What is drawn each frame: shown = rest + s (frame - rest) + (1 - s) b B, where `frame` is the last face given to
+ * setVertices, `rest` the model's rest face (setRestFace; the frame itself until one is given), s the speech weight
+ * (ramped towards 1 by setSpeaking(true), towards 0 by setSpeaking(false)), b the idle blink and B the blink
+ * field (eyelids.ts). The head pose is scaled by s the same way, so the head comes back to rest too.
+ *
+ * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { lipMask, type FaceTemplate } from '../template/face-template';
+import type { FaceTemplate } from '../template/face-template';
+import { Head } from './head';
+import { blinkField } from './eyelids';
+import { IdleMotion, type IdleState } from './idle-motion';
+import { heat, lightScene } from './materials';
 
-const SKIN_COLOR = 0xe0ac8e;
-const EYE_COLOR = 0xf4f1ec;
-const IRIS_COLOR = 0x3b2a1e;
-const MOUTH_COLOR = 0x2a0a0c;
-const LIP_COLOR = 0xb8676a;
+export interface FaceViewOptions {
+  /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
+  life?: boolean;
+  /** Seed of the idle motion's schedule (default 1). */
+  seed?: number;
+}
+
+/** Seconds for speech to blend in, and back out to the rest face. */
+const BLEND_IN = 0.12, BLEND_OUT = 0.4;
 const scratchAxis = new THREE.Vector3();
+const scratchQ = new THREE.Quaternion();
+const eyeTarget = new THREE.Vector3();
 
 export class FaceView {
   readonly renderer: THREE.WebGLRenderer;
   readonly scene = new THREE.Scene();
   readonly camera: THREE.PerspectiveCamera;
   readonly controls: OrbitControls;
+  /** The whole head's parts (head.ts). */
+  readonly model: Head;
   /** Everything that moves with the head pose T_p. */
-  readonly head = new THREE.Group();
-  private readonly face: THREE.Mesh<THREE.BufferGeometry, THREE.MeshStandardMaterial>;
-  private readonly positions: THREE.BufferAttribute;
+  readonly head: THREE.Group;
+  /** The last idle state drawn (null without life). */
+  idleState: IdleState | null = null;
+  private readonly idle: IdleMotion | null;
+  private readonly blink: Float32Array;
+  private readonly shown: Float32Array;
+  private readonly frame: Float32Array;
+  private rest: Float32Array | null = null;
+  private hasFrame = false;
+  private speech = 1;
+  private speechTarget = 1;
+  private tongue = 0;
+  private readonly pose = new Float32Array(6);
   private readonly resizeObserver: ResizeObserver;
   private needsRender = true;
   private frameHandle = 0;
-  private readonly skin: Float32Array;
+  private lastTime = -1;
+  private readonly faceRadius: number;
+  private readonly frameSize: { height: number; width: number };
+  private readonly environment: THREE.Texture;
+  private readonly bodyHeight: number;
   private arrows: { template: THREE.ArrowHelper; current: THREE.ArrowHelper } | null = null;
 
   constructor(
     private readonly canvas: HTMLCanvasElement,
     readonly template: FaceTemplate,
+    options: FaceViewOptions = {},
   ) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
     this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
-    this.scene.background = new THREE.Color(0x1d2230);
+    this.model = new Head(template);
+    this.head = this.model.group;
+    this.scene.add(this.head, this.model.body);
+    this.environment = lightScene(this.scene, this.renderer);
+    this.shown = new Float32Array(template.positions);
+    this.frame = new Float32Array(template.positions);
+    this.blink = blinkField(template);
+    this.idle = options.life === false ? null : new IdleMotion(options.seed ?? 1);
+    this.bodyHeight = this.model.body.scale.y;
 
-    const geometry = new THREE.BufferGeometry();
-    this.positions = new THREE.BufferAttribute(new Float32Array(template.positions), 3);
-    this.positions.setUsage(THREE.DynamicDrawUsage);
-    geometry.setAttribute('position', this.positions);
-    if (template.uvs) geometry.setAttribute('uv', new THREE.BufferAttribute(template.uvs, 2));
-    geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
-    this.skin = skinColors(template);
-    geometry.setAttribute('color', new THREE.BufferAttribute(this.skin.slice(), 3));
-    geometry.computeVertexNormals();
-    geometry.computeBoundingSphere();
-    this.face = new THREE.Mesh(
-      geometry,
-      new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.62, metalness: 0, side: THREE.DoubleSide }),
-    );
-    this.face.name = 'face';
-    this.head.add(this.face);
-    this.addEyes();
-    this.addMouthBacking();
-    this.scene.add(this.head);
-
-    this.scene.add(new THREE.HemisphereLight(0xfff4ea, 0x39303a, 1.1));
-    const key = new THREE.DirectionalLight(0xffffff, 2.0);
-    key.position.set(0.6, 0.8, 1.5);
-    this.scene.add(key);
-    const rim = new THREE.DirectionalLight(0x9ab4ff, 0.6);
-    rim.position.set(-1, 0.4, -0.8);
-    this.scene.add(rim);
-
-    const sphere = geometry.boundingSphere!;
-    this.camera = new THREE.PerspectiveCamera(30, 1, sphere.radius / 20, sphere.radius * 40);
-    this.camera.position.set(sphere.center.x, sphere.center.y, sphere.center.z + sphere.radius * 3.6);
+    const m = this.model.measures;
+    const H = m.top - m.chin;
+    const crown = this.model.shell ? this.model.shell.egg.center[1] + this.model.shell.egg.up : m.top;
+    const target = new THREE.Vector3(m.centerX, (crown + m.chin) / 2 - 0.02 * H, m.sideZ + 0.3 * m.halfWidth);
+    // What the camera frames: the head from crown to chin with a margin, and a little more than its width.
+    this.frameSize = { height: 1.12 * (crown - m.chin), width: 2.5 * m.halfWidth };
+    const face = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(template.positions, 3));
+    face.computeBoundingSphere();
+    this.faceRadius = face.boundingSphere!.radius;
+    this.camera = new THREE.PerspectiveCamera(30, 1, H / 40, H * 40);
+    this.camera.position.set(target.x, target.y, target.z + 3.3 * H);
     this.controls = new OrbitControls(this.camera, canvas);
-    this.controls.target.copy(sphere.center);
+    this.controls.target.copy(target);
     this.controls.enableDamping = true;
     this.controls.addEventListener('change', () => this.requestRender());
     this.controls.update();
@@ -80,32 +99,53 @@ export class FaceView {
     this.resizeObserver = new ResizeObserver(() => this.resize());
     this.resizeObserver.observe(canvas);
     this.resize();
+    this.compose();
     this.loop();
   }
 
-  /** Replace the face's vertices (N x 3, template units) in place. */
-  /** The vertices drawn now (template units), read-only. */
+  /** The face's vertices drawn now (template units, N x 3), read-only. */
   get shownVertices(): Float32Array {
-    return this.positions.array as Float32Array;
+    return this.shown;
   }
 
+  /** The speech weight s now (0: the rest face, 1: the frame given). */
+  get speechWeight(): number {
+    return this.speech;
+  }
+
+  /** The face's vertices for this frame (N x 3, template units): I + O from the model, or any face. */
   setVertices(vertices: Float32Array): void {
-    if (vertices.length !== this.positions.array.length) {
-      throw new Error(`setVertices: expected ${this.positions.array.length / 3} vertices, got ${vertices.length / 3}`);
+    if (vertices.length !== this.frame.length) {
+      throw new Error(`setVertices: expected ${this.frame.length / 3} vertices, got ${vertices.length / 3}`);
     }
-    (this.positions.array as Float32Array).set(vertices);
-    this.positions.needsUpdate = true;
-    this.face.geometry.computeVertexNormals();
+    this.frame.set(vertices);
+    this.hasFrame = true;
+    this.compose();
+  }
+
+  /** The model's rest face (N x 3): what the face shows when no speech is, and what speech blends from. */
+  setRestFace(rest: Float32Array): void {
+    if (rest.length !== this.frame.length) throw new Error(`setRestFace: expected ${this.frame.length / 3} vertices, got ${rest.length / 3}`);
+    this.rest = rest.slice();
+    if (!this.hasFrame) this.speech = this.speechTarget = 0;
+    this.compose();
+  }
+
+  /** Blend speech in (the frames given are shown) or out (back to the rest face), over a fraction of a second. */
+  setSpeaking(on: boolean): void {
+    this.speechTarget = on ? 1 : 0;
     this.requestRender();
   }
 
-  /** Head pose y = R x + t: axis-angle (radians) and translation (template units), applied to face, eyes and mouth. */
+  /** How raised the tongue is, 0..1 (Frames.tongue): drawn with the next setVertices (give it first). */
+  setTongue(raise: number): void {
+    this.tongue = raise;
+  }
+
+  /** Head pose y = R x + t: axis-angle (radians) and translation (template units), applied to the whole head. */
   setPose(rx: number, ry: number, rz: number, tx: number, ty: number, tz: number): void {
-    const angle = Math.hypot(rx, ry, rz);
-    if (angle < 1e-9) this.head.quaternion.identity();
-    else this.head.quaternion.setFromAxisAngle(scratchAxis.set(rx / angle, ry / angle, rz / angle), angle);
-    this.head.position.set(tx, ty, tz);
-    this.requestRender();
+    this.pose.set([rx, ry, rz, tx, ty, tz]);
+    this.applyPose();
   }
 
   requestRender(): void {
@@ -117,30 +157,33 @@ export class FaceView {
    * e.g. an error in mm or an attention weight; null restores the skin colours.
    */
   setColorMap(values: ArrayLike<number> | null, max = 1): void {
-    const color = this.face.geometry.getAttribute('color') as THREE.BufferAttribute;
-    const c = color.array as Float32Array;
-    if (!values) c.set(this.skin);
+    if (!values) this.model.paint(null);
     else {
       if (values.length !== this.template.vertexCount) throw new Error(`setColorMap: expected ${this.template.vertexCount} values, got ${values.length}`);
+      const c = new Float32Array(values.length * 3);
       for (let v = 0; v < values.length; v++) heat(Math.min(1, Math.max(0, values[v] / (max || 1))), c, 3 * v);
+      this.model.paint(c);
     }
-    color.needsUpdate = true;
     this.requestRender();
   }
 
-  /** The vertex nearest the point under (clientX, clientY) on the face, or null if the face is not there. */
+  /** The face vertex nearest the point under (clientX, clientY), or null if the face is not there. */
   pickVertex(clientX: number, clientY: number): number | null {
     const r = this.canvas.getBoundingClientRect();
     const ndc = new THREE.Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
     const ray = new THREE.Raycaster();
     ray.setFromCamera(ndc, this.camera);
-    this.face.geometry.computeBoundingSphere();
-    const hit = ray.intersectObject(this.face, false)[0];
+    const skin = this.model.skin;
+    skin.geometry.computeBoundingSphere();
+    skin.geometry.computeBoundingBox();
+    const hit = ray.intersectObject(skin, false)[0];
     if (!hit?.face) return null;
-    const local = this.face.worldToLocal(hit.point.clone());
-    let best = hit.face.a, bestD = Infinity;
+    const local = skin.worldToLocal(hit.point.clone());
+    const pos = skin.geometry.getAttribute('position') as THREE.BufferAttribute;
+    let best: number | null = null, bestD = Infinity;
     for (const v of [hit.face.a, hit.face.b, hit.face.c]) {
-      const d = local.distanceToSquared(new THREE.Vector3().fromBufferAttribute(this.positions, v));
+      if (v >= this.template.vertexCount) continue; // the shell or the mouth: not the model's face
+      const d = local.distanceToSquared(new THREE.Vector3().fromBufferAttribute(pos, v));
       if (d < bestD) [best, bestD] = [v, d];
     }
     return best;
@@ -154,10 +197,10 @@ export class FaceView {
     if (on && !this.arrows) {
       const tip = this.template.regions.nose_tip?.[0];
       if (tip === undefined) return;
-      const geometry = this.face.geometry;
-      const origin = new THREE.Vector3().fromBufferAttribute(this.positions, tip);
+      const geometry = this.model.skin.geometry;
+      const origin = new THREE.Vector3().fromArray(this.template.positions, 3 * tip);
       const normal = new THREE.Vector3().fromBufferAttribute(geometry.getAttribute('normal') as THREE.BufferAttribute, tip).normalize();
-      const length = geometry.boundingSphere!.radius * 0.9;
+      const length = this.faceRadius * 0.9;
       const template = new THREE.ArrowHelper(normal, origin, length, 0xb0b6c4, length * 0.15, length * 0.07);
       const current = new THREE.ArrowHelper(normal, origin, length, 0xff8a3d, length * 0.15, length * 0.07);
       template.name = 'pose_arrow_template';
@@ -173,101 +216,87 @@ export class FaceView {
     this.requestRender();
   }
 
+  /** Advance the life and speech blend to `seconds` and pose the head for it (the frame loop calls this). */
+  update(seconds: number): void {
+    const dt = this.lastTime < 0 ? 0 : Math.max(0, seconds - this.lastTime);
+    this.lastTime = seconds;
+    let changed = false;
+    if (this.speech !== this.speechTarget && this.rest) {
+      const step = dt / (this.speechTarget > this.speech ? BLEND_IN : BLEND_OUT);
+      this.speech = this.speechTarget > this.speech ? Math.min(1, this.speech + step) : Math.max(0, this.speech - step);
+      changed = true;
+    } else if (!this.rest) this.speech = this.speechTarget;
+    const before = this.idleState?.blink ?? 0;
+    if (this.idle) {
+      this.idleState = this.idle.at(seconds);
+      changed ||= this.idleState.blink > 0 || before > 0;
+    }
+    if (changed) this.compose();
+    this.applyPose();
+    this.head.updateMatrixWorld();
+    eyeTarget.copy(this.camera.position);
+    this.head.worldToLocal(eyeTarget);
+    const s = this.idleState;
+    this.model.eyes.lookAt(eyeTarget, s?.yaw ?? 0, s?.pitch ?? 0);
+    if (s) this.model.body.scale.y = this.bodyHeight * (1 + 0.012 * s.breath);
+  }
+
   dispose(): void {
     cancelAnimationFrame(this.frameHandle);
     this.resizeObserver.disconnect();
     this.controls.dispose();
-    this.scene.traverse((o) => {
-      if (o instanceof THREE.Mesh) {
-        o.geometry.dispose();
-        (o.material as THREE.Material).dispose();
-      }
-    });
+    this.model.dispose();
+    this.environment.dispose();
     this.renderer.dispose();
+  }
+
+  /** shown = rest + s (frame - rest) + (1 - s) b B, then everything that follows the face. */
+  private compose(): void {
+    const f = this.frame, out = this.shown;
+    const rest = this.rest ?? f;
+    const s = this.rest ? this.speech : 1;
+    const b = (this.idleState?.blink ?? 0) * (1 - s);
+    for (let i = 0; i < out.length; i++) out[i] = rest[i] + s * (f[i] - rest[i]) + b * this.blink[i];
+    this.model.setFace(out, this.tongue * s);
+    this.requestRender();
+  }
+
+  /** The model's pose scaled by the speech weight, and breathing on top: the chest lifts the head a little. */
+  private applyPose(): void {
+    const s = this.rest ? this.speech : 1;
+    const [rx, ry, rz, tx, ty, tz] = this.pose;
+    const angle = Math.hypot(rx, ry, rz) * s;
+    if (angle < 1e-9) this.head.quaternion.identity();
+    else this.head.quaternion.setFromAxisAngle(scratchAxis.set(rx, ry, rz).normalize(), angle);
+    const breath = this.idleState?.breath ?? 0;
+    const H = this.model.measures.top - this.model.measures.chin;
+    this.head.quaternion.multiply(scratchQ.setFromAxisAngle(scratchAxis.set(1, 0, 0), -0.004 * breath));
+    this.head.position.set(tx * s, ty * s + 0.0035 * H * breath, tz * s);
+    this.requestRender();
   }
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
+    if (this.idle || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
     if (!this.needsRender) return;
     this.needsRender = false;
     this.renderer.render(this.scene, this.camera);
   };
 
+  /** Fit the head in the canvas (a new size resets the zoom, not the direction the camera looks from). */
   private resize(): void {
     const w = Math.max(1, this.canvas.clientWidth);
     const h = Math.max(1, this.canvas.clientHeight);
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
+    const tan = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2));
+    const distance = Math.max(this.frameSize.height / (2 * tan), this.frameSize.width / (2 * tan * this.camera.aspect));
+    const t = this.controls.target;
+    this.camera.position.sub(t).setLength(distance).add(t);
+    this.controls.update();
     this.requestRender();
   }
-
-  /** An eyeball behind each lid opening, sized from the opening so any template gets fitting eyes. */
-  private addEyes(): void {
-    const r = this.template.regions;
-    for (const side of ['left', 'right'] as const) {
-      const loop = [...r[`eye_${side}_upper`], ...r[`eye_${side}_lower`]];
-      const { center, size, maxZ } = this.bounds(loop);
-      const radius = size.x * 0.62;
-      const eye = new THREE.Group();
-      eye.name = `eye_${side}`;
-      const ball = new THREE.Mesh(new THREE.SphereGeometry(radius, 32, 16), new THREE.MeshStandardMaterial({ color: EYE_COLOR, roughness: 0.25 }));
-      const iris = new THREE.Mesh(
-        new THREE.CircleGeometry(radius * 0.34, 32),
-        new THREE.MeshStandardMaterial({ color: IRIS_COLOR, roughness: 0.3 }),
-      );
-      iris.position.z = radius * 1.001;
-      eye.add(ball, iris);
-      // The front of the ball sits just behind the deepest lid vertex.
-      eye.position.set(center.x, center.y, maxZ - radius - size.z * 0.15);
-      this.head.add(eye);
-    }
-  }
-
-  /** A dark ellipsoid behind the inner lips: what an open mouth shows instead of the mask's empty back. */
-  private addMouthBacking(): void {
-    const r = this.template.regions;
-    const { center, size } = this.bounds([...r.lips_inner_upper, ...r.lips_inner_lower]);
-    const outer = this.bounds(Array.from(r.lips_outer));
-    const mouth = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), new THREE.MeshStandardMaterial({ color: MOUTH_COLOR, roughness: 0.9 }));
-    mouth.name = 'mouth_backing';
-    const halfWidth = size.x * 0.5;
-    mouth.scale.set(halfWidth * 0.95, outer.size.y * 0.9, halfWidth * 0.8);
-    mouth.position.set(center.x, center.y - outer.size.y * 0.15, outer.minZ - halfWidth * 0.35);
-    this.head.add(mouth);
-  }
-
-  private bounds(indices: ArrayLike<number>): { center: THREE.Vector3; size: THREE.Vector3; maxZ: number; minZ: number } {
-    const box = new THREE.Box3();
-    const p = new THREE.Vector3();
-    const pos = this.template.positions;
-    for (let i = 0; i < indices.length; i++) box.expandByPoint(p.fromArray(pos, 3 * indices[i]));
-    return { center: box.getCenter(new THREE.Vector3()), size: box.getSize(new THREE.Vector3()), maxZ: box.max.z, minZ: box.min.z };
-  }
-}
-
-/**
- * Per-vertex colours: skin, with the lips tinted. The lip surface is found by
- * flooding the 1-ring graph from the inner-lip contour outward and stopping at
- * the outer-lip contour, so it works for any template with those regions.
- */
-/** A blue -> cyan -> green -> yellow -> red ramp at t in [0, 1], written to out[at..at+3). */
-function heat(t: number, out: Float32Array, at: number): void {
-  const stops = [[0.12, 0.16, 0.45], [0.1, 0.65, 0.85], [0.25, 0.8, 0.3], [0.95, 0.85, 0.2], [0.85, 0.15, 0.12]];
-  const x = t * (stops.length - 1);
-  const k = Math.min(stops.length - 2, Math.floor(x));
-  const f = x - k;
-  for (let i = 0; i < 3; i++) out[at + i] = stops[k][i] * (1 - f) + stops[k + 1][i] * f;
-}
-
-function skinColors(t: FaceTemplate): Float32Array {
-  const skin = new THREE.Color(SKIN_COLOR);
-  const lip = new THREE.Color(LIP_COLOR);
-  const colors = new Float32Array(t.vertexCount * 3);
-  for (let v = 0; v < t.vertexCount; v++) skin.toArray(colors, 3 * v);
-  const isLip = lipMask(t);
-  for (let v = 0; v < t.vertexCount; v++) if (isLip[v]) lip.toArray(colors, 3 * v);
-  return colors;
 }

@@ -10,8 +10,11 @@ type TF = {
   take: { name: string; animation: { frames: number; fps: number }; truth?: { frames: number } } | null;
   view: { scene: { getObjectByName(n: string): unknown } };
   exportGlb(): Promise<{ bytes: ArrayBuffer; frames: number; encoding: string; morphTargets: number; maxErrorMm: number }>;
-  inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number }>;
+  inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[] }>;
 };
+/** Vertices of the whole head's skin buffer (face, then shell and mouth cavity): what the .glb's morphed mesh holds. */
+const headVertices = (page: import('@playwright/test').Page) =>
+  page.evaluate(() => (globalThis as unknown as { talkingFace: { view: { model: { vertices: Float32Array } } } }).talkingFace.view.model.vertices.length / 3);
 
 test('sample clip: heat map, side by side, pose arrows, attention maps, exports', async ({ page }) => {
   test.setTimeout(120_000);
@@ -56,7 +59,7 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   await expect(page.locator('#legend')).toContainText(/Vertex \d+'s attention over itself and its \d+ neighbours/);
   await test.info().attach('attention.png', { body: await page.locator('#stage').screenshot(), contentType: 'image/png' });
 
-  // .glb: re-loads in three.js with one morph target per frame and the clip's duration.
+  // .glb: re-loads in three.js with the whole head, one morph target per frame and the clip's duration.
   const glb = await page.evaluate(async () => {
     const g = await (globalThis as unknown as { talkingFace: TF }).talkingFace.exportGlb();
     return { frames: g.frames, encoding: g.encoding, info: await (globalThis as unknown as { talkingFace: TF }).talkingFace.inspectGlb(g.bytes) };
@@ -65,8 +68,12 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   expect(glb.encoding).toBe('per-frame');
   expect(glb.info.morphTargets).toBe(take.frames);
   expect(glb.info.clips).toBe(1);
-  expect(glb.info.vertices).toBe(468);
+  expect(glb.info.vertices).toBe(await headVertices(page));
+  expect(glb.info.vertices).toBeGreaterThan(468);
   expect(glb.info.duration).toBeCloseTo((take.frames - 1) / FPS, 3);
+  // The new parts are there and animated: the head pose, the face, the jaw (lower teeth, tongue), the tongue's raise, the gaze.
+  expect(glb.info.parts).toEqual(expect.arrayContaining(['talking-face', 'face', 'neck', 'eye_left', 'eye_right', 'teeth_upper', 'jaw_lower', 'teeth_lower', 'tongue']));
+  expect(glb.info.animated.sort()).toEqual(['eye_left', 'eye_right', 'face', 'jaw_lower', 'talking-face', 'tongue']);
 
   // Raw frames: float32 frames x N x 3.
   const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-raw').click()]);
@@ -95,9 +102,9 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.frames).toBe(frames);
   expect(glb.encoding).toBe('components');
   expect(glb.info.morphTargets).toBe(8);
-  expect(glb.info.vertices).toBe(468);
+  expect(glb.info.vertices).toBe(await headVertices(page));
   expect(glb.info.duration).toBeCloseTo((frames - 1) / FPS, 3);
-  expect(glb.bytes).toBeLessThan(1e6); // per-frame targets would be ~28 MB
+  expect(glb.bytes).toBeLessThan(2e6); // per-frame targets would be ~100 MB
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
   // The page says what it did.
   await page.locator('#export-glb').click();

@@ -31,12 +31,14 @@ test.describe('the face viewer', () => {
     await expect(page.locator('#status')).toContainText('WebGPU adapter: google swiftshader');
   });
 
-  test('draws eyeballs and the inner-mouth backing', async ({ page }) => {
+  test('draws a whole head: skull and neck around the face, eyes, teeth, tongue, the mouth inside', async ({ page }) => {
     const names = await page.evaluate(() => {
-      const v = (globalThis as unknown as { talkingFace: { view: { head: { children: { name: string }[] } } } }).talkingFace.view;
-      return v.head.children.map((c) => c.name);
+      const v = (globalThis as unknown as { talkingFace: { view: { head: { traverse(f: (o: { name: string }) => void): void } } } }).talkingFace.view;
+      const all: string[] = [];
+      v.head.traverse((o) => all.push(o.name));
+      return all;
     });
-    expect(names).toEqual(expect.arrayContaining(['face', 'eye_left', 'eye_right', 'mouth_backing']));
+    expect(names).toEqual(expect.arrayContaining(['face', 'neck', 'eye_left', 'eye_right', 'eyeball_left', 'teeth_upper', 'jaw_lower', 'teeth_lower', 'tongue']));
   });
 
   test('follows the window size', async ({ page }) => {

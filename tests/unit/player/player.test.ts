@@ -11,12 +11,15 @@ import type { BlendshapeFrames } from '../../../src/avatar/weights';
 /** A face view that records what it was given. */
 function fakeView() {
   const shown: { vertices: number[]; pose: number[] }[] = [];
+  const speaking: boolean[] = [];
   let last: number[] = [];
   const view = {
     setVertices: (v: Float32Array) => (last = Array.from(v)),
     setPose: (...p: number[]) => shown.push({ vertices: last, pose: p }),
+    setTongue: () => undefined,
+    setSpeaking: (on: boolean) => speaking.push(on),
   } as unknown as FaceView;
-  return { view, shown };
+  return { view, shown, speaking };
 }
 
 /** Two vertices, `frames` frames: vertex values f, poses f (rotation) and 10 f (mm). */
@@ -27,6 +30,7 @@ function animation(frames: number): Animation {
     unposed: Float32Array.from({ length: frames * 6 }, (_, i) => Math.floor(i / 6)),
     pose: Float32Array.from({ length: frames * 6 }, (_, i) => (i % 6 < 3 ? Math.floor(i / 6) : 10 * Math.floor(i / 6))),
     phones: new Uint8Array(frames),
+    tongue: new Float32Array(frames),
   };
 }
 
@@ -86,7 +90,7 @@ describe('Player', () => {
     p.load(a, {} as AudioBuffer);
     p.show(2);
     expect(got).toEqual([[2, 0.5]]);
-    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), blendshapes: a.blendshapes });
+    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), tongue: new Float32Array(3), blendshapes: a.blendshapes });
     expect(got[1]).toEqual([2, 0.5]); // the chunk's last frame
     p.load(animation(4), {} as AudioBuffer); // a take without blend shapes: nothing to hand over
     p.show(1);

@@ -1,0 +1,135 @@
+import { test, expect } from './fixtures';
+
+/**
+ * The whole head (src/render/): at rest its mouth stays closed while it blinks and moves its eyes; on an open
+ * vowel the mouth shows its inside (teeth, tongue, cavity), never the page behind the head.
+ */
+type View = {
+  shownVertices: Float32Array;
+  speechWeight: number;
+  model: { eyes: { left: { rotation: { x: number; y: number } } } };
+};
+type TF = { view: View; template: { positions: Float32Array; regions: Record<string, Uint32Array> }; engine: { unitsPerMm: number }; take: { animation: { frames: number; unposed: Float32Array } } | null };
+
+test('at rest the face keeps its mouth closed, blinks and moves its eyes within 6 s', async ({ page }) => {
+  test.setTimeout(90_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  // Watch the drawn face for 6 s, every animation frame.
+  const seen = await page.evaluate(() => new Promise<{ maxLipGapMm: number; openLid: number; minLid: number; eyeTurn: number; frames: number }>((resolve) => {
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
+    const r = tf.template.regions;
+    const only = (a: Uint32Array, b: Uint32Array) => Array.from(a).filter((v) => !b.includes(v));
+    const meanY = (p: Float32Array, vs: number[]) => vs.reduce((s, v) => s + p[3 * v + 1], 0) / vs.length;
+    const [lipUp, lipLo] = [only(r.lips_inner_upper, r.lips_inner_lower), only(r.lips_inner_lower, r.lips_inner_upper)];
+    const [lidUp, lidLo] = [only(r.eye_left_upper, r.eye_left_lower), only(r.eye_left_lower, r.eye_left_upper)];
+    const openLid = meanY(tf.template.positions, lidUp) - meanY(tf.template.positions, lidLo);
+    let maxLipGapMm = -Infinity, minLid = Infinity, frames = 0;
+    const yaw: number[] = [], pitch: number[] = [];
+    const t0 = performance.now();
+    const tick = () => {
+      const p = tf.view.shownVertices;
+      maxLipGapMm = Math.max(maxLipGapMm, (meanY(p, lipUp) - meanY(p, lipLo)) / tf.engine.unitsPerMm);
+      minLid = Math.min(minLid, meanY(p, lidUp) - meanY(p, lidLo));
+      yaw.push(tf.view.model.eyes.left.rotation.y);
+      pitch.push(tf.view.model.eyes.left.rotation.x);
+      frames++;
+      if (performance.now() - t0 < 6000) requestAnimationFrame(tick);
+      else resolve({ maxLipGapMm, openLid, minLid, frames, eyeTurn: Math.max(Math.max(...yaw) - Math.min(...yaw), Math.max(...pitch) - Math.min(...pitch)) });
+    };
+    requestAnimationFrame(tick);
+  }));
+  console.log(`idle 6 s (${seen.frames} frames): inner-lip gap at most ${seen.maxLipGapMm.toFixed(2)} mm, lids closed to ${(100 * seen.minLid / seen.openLid).toFixed(0)}% of open, eyes turned over ${(seen.eyeTurn * 180 / Math.PI).toFixed(2)} deg`);
+  expect(seen.maxLipGapMm, 'inner-lip gap at rest (mm)').toBeLessThan(1);
+  expect(seen.minLid / seen.openLid, 'a blink closes the lids').toBeLessThan(0.2);
+  expect(seen.eyeTurn, 'the eyes moved (radians)').toBeGreaterThan((0.5 * Math.PI) / 180);
+});
+
+test('an open vowel shows the inside of the mouth, with no background pixel inside the lips', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
+  await page.locator('#sample-select').selectOption(first!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  // The widest-open frame of the take (the inner-lip gap at the mouth's middle).
+  const open = await page.evaluate(() => {
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
+    const a = tf.take!.animation, n3 = a.unposed.length / a.frames, r = tf.template.regions;
+    const up = Array.from(r.lips_inner_upper).filter((v) => !r.lips_inner_lower.includes(v));
+    const lo = Array.from(r.lips_inner_lower).filter((v) => !r.lips_inner_upper.includes(v));
+    const meanY = (f: number, vs: number[]) => vs.reduce((s, v) => s + a.unposed[f * n3 + 3 * v + 1], 0) / vs.length;
+    let best = 0, gap = -Infinity;
+    for (let f = 0; f < a.frames; f++) if (meanY(f, up) - meanY(f, lo) > gap) [best, gap] = [f, meanY(f, up) - meanY(f, lo)];
+    return { frame: best, gapMm: gap / tf.engine.unitsPerMm };
+  });
+  expect(open.gapMm, 'the take opens its mouth').toBeGreaterThan(5);
+  await page.locator('#scrub').fill(String(open.frame));
+  await expect.poll(() => page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.view.speechWeight)).toBe(1);
+  const png = (await page.locator('#face-canvas').screenshot()).toString('base64');
+  const result = await page.evaluate(async (b64) => {
+    type M4 = { elements: number[] };
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
+    const view = tf.view as unknown as { camera: { projectionMatrix: M4; matrixWorldInverse: M4 }; model: { bag: { rim: number[] }; skin: { matrixWorld: M4 } } };
+    const mul = (m: number[], v: number[]) => [0, 1, 2, 3].map((r) => m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * v[3]);
+    const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+    const c = new OffscreenCanvas(bmp.width, bmp.height);
+    const ctx = c.getContext('2d')!;
+    ctx.drawImage(bmp, 0, 0);
+    const { data, width, height } = ctx.getImageData(0, 0, bmp.width, bmp.height);
+    const bg = [data[0], data[1], data[2]];
+    // The inner-lip loop on screen, shrunk 10% towards its centre (the lips' own anti-aliased edge stays out).
+    const p = tf.view.shownVertices;
+    const pts = view.model.bag.rim.map((v) => {
+      const world = mul(view.model.skin.matrixWorld.elements, [p[3 * v], p[3 * v + 1], p[3 * v + 2], 1]);
+      const clip = mul(view.camera.projectionMatrix.elements, mul(view.camera.matrixWorldInverse.elements, world));
+      return [((clip[0] / clip[3] + 1) / 2) * width, ((1 - clip[1] / clip[3]) / 2) * height];
+    });
+    const cx = pts.reduce((s, q) => s + q[0], 0) / pts.length, cy = pts.reduce((s, q) => s + q[1], 0) / pts.length;
+    const poly = pts.map(([x, y]) => [cx + 0.9 * (x - cx), cy + 0.9 * (y - cy)]);
+    const inside = (x: number, y: number) => {
+      let r = false;
+      for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
+        const [xi, yi] = poly[i], [xj, yj] = poly[j];
+        if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) r = !r;
+      }
+      return r;
+    };
+    let pixels = 0, background = 0;
+    for (let y = 0; y < height; y++)
+      for (let x = 0; x < width; x++) {
+        if (!inside(x + 0.5, y + 0.5)) continue;
+        pixels++;
+        const i = 4 * (y * width + x);
+        if (Math.abs(data[i] - bg[0]) + Math.abs(data[i + 1] - bg[1]) + Math.abs(data[i + 2] - bg[2]) <= 24) background++;
+      }
+    return { pixels, background };
+  }, png);
+  console.log(`open vowel (frame ${open.frame}, inner-lip gap ${open.gapMm.toFixed(1)} mm): ${result.pixels} pixels inside the lips, ${result.background} of them background`);
+  await test.info().attach('open-vowel.png', { body: Buffer.from(png, 'base64'), contentType: 'image/png' });
+  expect(result.pixels, 'the open mouth covers some pixels').toBeGreaterThan(40);
+  expect(result.background, 'background pixels inside the lips').toBe(0);
+});
+
+test('after speech the face blends back to its rest, mouth closed', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
+  await page.locator('#sample-select').selectOption(first!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  const weight = () => page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.view.speechWeight);
+  await expect.poll(weight).toBe(1); // a take's frame is shown
+  await page.locator('#play-button').click();
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+  await expect(page.locator('#play-button')).toHaveText('Play', { timeout: 30_000 }); // the end of the take
+  await expect.poll(weight, { timeout: 5_000 }).toBe(0);
+  const gapMm = await page.evaluate(() => {
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace, r = tf.template.regions, p = tf.view.shownVertices;
+    const up = Array.from(r.lips_inner_upper).filter((v) => !r.lips_inner_lower.includes(v));
+    const lo = Array.from(r.lips_inner_lower).filter((v) => !r.lips_inner_upper.includes(v));
+    const meanY = (vs: number[]) => vs.reduce((s, v) => s + p[3 * v + 1], 0) / vs.length;
+    return (meanY(up) - meanY(lo)) / tf.engine.unitsPerMm;
+  });
+  expect(gapMm, 'inner-lip gap after speech (mm)').toBeLessThan(1);
+});
