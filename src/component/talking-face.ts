@@ -17,6 +17,7 @@ import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
+import { sharedEngine } from './engines';
 import { Player, audioNotes, type PlayerView } from '../player/player';
 import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
@@ -24,20 +25,6 @@ export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events'
 
 /** The model an element loads when it has no `model` attribute. */
 export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
-
-const engines = new Map<string, Promise<TalkingFaceEngine>>();
-
-function sharedEngine(model: string, template: string | null, backend: string): Promise<TalkingFaceEngine> {
-  const key = `${model}|${template ?? ''}|${backend}`;
-  let p = engines.get(key);
-  if (!p) {
-    p = TalkingFaceEngine.load({ manifestUrl: model, templateUrl: template ?? undefined, backend: backend as 'auto' | Backend });
-    engines.set(key, p);
-    // Forget a failed load so a later element can retry it; the failure itself reaches the caller through `p`.
-    p.catch(() => engines.delete(key));
-  }
-  return p;
-}
 
 const STYLE = `
 :host { display: block; position: relative; width: 100%; aspect-ratio: 4 / 3; min-height: 160px; background: #15181d; border-radius: 8px; overflow: hidden; contain: content; }
