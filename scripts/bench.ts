@@ -1,9 +1,11 @@
 /**
  * npm run bench: the engine's speed and memory on this machine, in headless Chromium.
- * Builds the app, serves it, opens dev/bench.html, and writes docs/results/bench.json plus a table.
+ * Builds the app, serves it, measures the demo's first load (bytes per file, time to ready: scripts/first-load.ts),
+ * opens dev/bench.html, and writes docs/results/bench.json plus a table.
  * WebGPU here is SwiftShader (software): its figures are reported, not GPU figures.
  *
- *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]
+ *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]     (BENCH_PORT=... to serve on another port than 4191)
+ *   npm run bench -- --first-load-only                            (the first load alone, printed; nothing written)
  */
 import { chromium } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
@@ -17,6 +19,7 @@ import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
+import { measureFirstLoad, printFirstLoad, type FirstLoad } from './first-load';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -26,7 +29,7 @@ const opt = (name: string, fallback: string) => {
 };
 const seconds = opt('--seconds', '10,60').split(',').map(Number);
 const backends = opt('--backends', 'cpu,webgpu').split(',');
-const PORT = 4191;
+const PORT = Number(process.env.BENCH_PORT ?? 4191);
 
 /** The parts of the engine that run the same in Node (no Web Audio, no WebGPU): Mel and the CPU decoders. */
 async function nodeBench(): Promise<Record<string, number | string>> {
@@ -66,7 +69,8 @@ async function nodeBench(): Promise<Record<string, number | string>> {
 }
 
 async function main(): Promise<void> {
-  const node = await nodeBench();
+  const firstLoadOnly = process.argv.includes('--first-load-only');
+  const node = firstLoadOnly ? {} : await nodeBench();
   if (process.argv.includes('--node-only')) {
     console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
     return;
@@ -83,6 +87,12 @@ async function main(): Promise<void> {
       }
     }
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
+    const firstLoad = await measureFirstLoad(browser, `http://127.0.0.1:${PORT}/`);
+    if (firstLoadOnly) {
+      printFirstLoad(firstLoad);
+      await browser.close();
+      return;
+    }
     const page = await browser.newPage();
     page.on('pageerror', (e) => console.error(`page error: ${e.message}`));
     await page.goto(`http://127.0.0.1:${PORT}/dev/bench.html`);
@@ -96,6 +106,7 @@ async function main(): Promise<void> {
     await browser.close();
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
     result.node = node;
+    result.first_load = firstLoad;
     result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
     mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
     writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
@@ -126,6 +137,7 @@ function print(r: Record<string, unknown>): void {
   const nd = r.node as Record<string, number> & { decoder_kernel: string };
   console.log(`Node: Mel ${f(nd.mel_ms_per_audio_second)} ms per audio second (Meyda.extract per frame: ${f(nd.mel_meyda_extract_ms_per_audio_second)}); ` +
     `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel} (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
+  printFirstLoad(r.first_load as FirstLoad);
   console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
 }
 

@@ -1,0 +1,111 @@
+/**
+ * How the build is served (issue 18): which files may be cached for how long, precompressed copies of what a
+ * browser downloads, and the preview server's static middleware that serves both. docs/embedding.md gives the
+ * same rules for a static host to copy.
+ *
+ *   hashed names (Vite's [name]-[hash].js under assets/ and lib/) and ort/<version>/   cached for a year, immutable
+ *   everything else (HTML, lib/talking-face.js, models/)                              revalidated (no-cache + ETag)
+ */
+import { brotliCompressSync, constants, gzipSync } from 'node:zlib';
+import { existsSync, readFileSync, readdirSync, statSync, writeFileSync, createReadStream } from 'node:fs';
+import { extname, join, normalize, resolve, sep } from 'node:path';
+import type { IncomingMessage, ServerResponse } from 'node:http';
+
+export const ISOLATION_HEADERS = {
+  'Cross-Origin-Opener-Policy': 'same-origin',
+  'Cross-Origin-Embedder-Policy': 'require-corp',
+};
+
+export const IMMUTABLE = 'public, max-age=31536000, immutable';
+export const REVALIDATE = 'no-cache';
+
+export const MIME: Record<string, string> = {
+  '.html': 'text/html; charset=utf-8',
+  '.js': 'text/javascript',
+  '.mjs': 'text/javascript',
+  '.css': 'text/css',
+  '.json': 'application/json',
+  '.svg': 'image/svg+xml',
+  '.wav': 'audio/wav',
+  '.onnx': 'application/octet-stream',
+  '.bin': 'application/octet-stream',
+  '.safetensors': 'application/octet-stream',
+  '.wasm': 'application/wasm',
+};
+
+/** Compressed with brotli at the highest quality (text) or a quicker one (large binaries: seconds, not minutes). */
+const TEXT = new Set(['.html', '.js', '.mjs', '.css', '.json', '.svg']);
+const BINARY = new Set(['.wasm', '.onnx', '.bin', '.safetensors']);
+
+/** The Cache-Control for a URL path of the build. */
+export function cacheControlFor(path: string): string {
+  if (/^\/ort\/\d+\.\d+\.\d+[^/]*\//.test(path)) return IMMUTABLE; // onnxruntime-web's files, under its version
+  if (/^\/(assets|lib)\/.*-[\w-]{8}\.(js|css)$/.test(path)) return IMMUTABLE; // Vite's content-hashed names
+  return REVALIDATE;
+}
+
+function* filesUnder(dir: string): Generator<string> {
+  for (const e of readdirSync(dir, { withFileTypes: true })) {
+    const p = join(dir, e.name);
+    if (e.isDirectory()) yield* filesUnder(p);
+    else if (e.isFile()) yield p;
+  }
+}
+
+/**
+ * Write `.br` and `.gz` beside every file under `dir` that a browser downloads and that compresses (1 KiB or
+ * more, and smaller by a twentieth at least), unless they are newer than the file already.
+ */
+export function precompress(dir: string): void {
+  for (const file of filesUnder(dir)) {
+    const ext = extname(file);
+    if (!TEXT.has(ext) && !BINARY.has(ext)) continue;
+    const st = statSync(file);
+    if (st.size < 1024 || (existsSync(`${file}.br`) && statSync(`${file}.br`).mtimeMs >= st.mtimeMs)) continue;
+    const bytes = readFileSync(file);
+    const quality = TEXT.has(ext) ? constants.BROTLI_MAX_QUALITY : 9;
+    const br = brotliCompressSync(bytes, { params: { [constants.BROTLI_PARAM_QUALITY]: quality, [constants.BROTLI_PARAM_SIZE_HINT]: bytes.length } });
+    if (br.length > 0.95 * bytes.length) continue;
+    writeFileSync(`${file}.br`, br);
+    writeFileSync(`${file}.gz`, gzipSync(bytes, { level: 9 }));
+  }
+}
+
+const ENCODINGS: [token: string, suffix: string][] = [['br', '.br'], ['gzip', '.gz']];
+
+/**
+ * Serve the files of the build under `root` (GET and HEAD): the precompressed copy the browser accepts, its
+ * Cache-Control, an ETag (a 304 when it matches), and the cross-origin isolation headers. Anything else
+ * (no such file, a Range request) goes on to the next middleware.
+ */
+export function serveBuild(root: string) {
+  return (req: IncomingMessage, res: ServerResponse, next: () => void): void => {
+    if ((req.method !== 'GET' && req.method !== 'HEAD') || req.headers.range) return next();
+    let path = decodeURIComponent((req.url ?? '/').split('?')[0]);
+    if (path.endsWith('/')) path += 'index.html';
+    const file = normalize(resolve(root, '.' + path));
+    if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) return next();
+    const accept = String(req.headers['accept-encoding'] ?? '');
+    const [encoding, suffix] = ENCODINGS.find(([token, sfx]) => new RegExp(`\\b${token}\\b`).test(accept) && existsSync(file + sfx)) ?? ['', ''];
+    const served = file + suffix;
+    const st = statSync(served);
+    const etag = `"${st.size.toString(36)}-${Math.floor(st.mtimeMs).toString(36)}${encoding ? `-${encoding}` : ''}"`;
+    res.setHeader('Content-Type', MIME[extname(file)] ?? 'application/octet-stream');
+    res.setHeader('Cache-Control', cacheControlFor(path));
+    res.setHeader('ETag', etag);
+    if (BINARY.has(extname(file)) || TEXT.has(extname(file))) res.setHeader('Vary', 'Accept-Encoding');
+    if (encoding) res.setHeader('Content-Encoding', encoding);
+    for (const [k, v] of Object.entries(ISOLATION_HEADERS)) res.setHeader(k, v);
+    if (req.headers['if-none-match'] === etag) {
+      res.statusCode = 304;
+      res.end();
+      return;
+    }
+    res.setHeader('Content-Length', st.size);
+    if (req.method === 'HEAD') {
+      res.end();
+      return;
+    }
+    createReadStream(served).pipe(res);
+  };
+}
