@@ -7,7 +7,8 @@
  *   everything else (HTML, lib/talking-face.js, models/)                              revalidated (no-cache + ETag)
  */
 import { brotliCompressSync, constants, gzipSync } from 'node:zlib';
-import { existsSync, readFileSync, readdirSync, statSync, writeFileSync, createReadStream } from 'node:fs';
+import { existsSync, mkdirSync, readFileSync, readdirSync, statSync, writeFileSync, createReadStream } from 'node:fs';
+import { createHash } from 'node:crypto';
 import { extname, join, normalize, resolve, sep } from 'node:path';
 import type { IncomingMessage, ServerResponse } from 'node:http';
 
@@ -52,22 +53,30 @@ function* filesUnder(dir: string): Generator<string> {
   }
 }
 
+/** Compressed copies already made, by content: a rebuild (or the next build of the same files) reuses them. */
+const CACHE = resolve(import.meta.dirname, '../node_modules/.cache/talking-face-precompressed');
+
 /**
  * Write `.br` and `.gz` beside every file under `dir` that a browser downloads and that compresses (1 KiB or
- * more, and smaller by a twentieth at least), unless they are newer than the file already.
+ * more, and smaller by a twentieth at least).
  */
 export function precompress(dir: string): void {
+  mkdirSync(CACHE, { recursive: true });
   for (const file of filesUnder(dir)) {
     const ext = extname(file);
-    if (!TEXT.has(ext) && !BINARY.has(ext)) continue;
-    const st = statSync(file);
-    if (st.size < 1024 || (existsSync(`${file}.br`) && statSync(`${file}.br`).mtimeMs >= st.mtimeMs)) continue;
+    if ((!TEXT.has(ext) && !BINARY.has(ext)) || statSync(file).size < 1024) continue;
     const bytes = readFileSync(file);
     const quality = TEXT.has(ext) ? constants.BROTLI_MAX_QUALITY : 9;
-    const br = brotliCompressSync(bytes, { params: { [constants.BROTLI_PARAM_QUALITY]: quality, [constants.BROTLI_PARAM_SIZE_HINT]: bytes.length } });
-    if (br.length > 0.95 * bytes.length) continue;
+    const cached = join(CACHE, `${createHash('sha256').update(bytes).digest('hex')}-q${quality}`);
+    if (!existsSync(`${cached}.br`)) {
+      const br = brotliCompressSync(bytes, { params: { [constants.BROTLI_PARAM_QUALITY]: quality, [constants.BROTLI_PARAM_SIZE_HINT]: bytes.length } });
+      writeFileSync(`${cached}.gz`, br.length > 0.95 * bytes.length ? Buffer.alloc(0) : gzipSync(bytes, { level: 9 }));
+      writeFileSync(`${cached}.br`, br.length > 0.95 * bytes.length ? Buffer.alloc(0) : br); // empty: not worth compressing
+    }
+    const br = readFileSync(`${cached}.br`);
+    if (!br.length) continue;
     writeFileSync(`${file}.br`, br);
-    writeFileSync(`${file}.gz`, gzipSync(bytes, { level: 9 }));
+    writeFileSync(`${file}.gz`, readFileSync(`${cached}.gz`));
   }
 }
 

@@ -6,6 +6,7 @@
 import type { Manifest, ModelConstants } from '../model/manifest';
 import { contentWindows, softmaxRows } from './windows';
 import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
+import { speechProbabilities } from './voice-activity';
 
 /** Content frames [lo, hi) and the Mel frames [melLo, melHi) that compute them exactly. */
 export interface ContentRange {
@@ -17,6 +18,8 @@ export interface ContentRange {
 
 export class ContentEncoder {
   private readonly m: ModelConstants;
+  /** The silence class (voice-activity.ts), or -1 for a model without one (every frame then counts as speech). */
+  private readonly silence: number;
 
   private constructor(
     private readonly manifest: Manifest,
@@ -24,12 +27,13 @@ export class ContentEncoder {
     private readonly hierarchical: OnnxModel,
   ) {
     this.m = manifest.model.config;
+    this.silence = manifest.content_phones.indexOf('SIL');
   }
 
-  static async create(manifest: Manifest, files: Record<string, ArrayBuffer>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
+  static async create(manifest: Manifest, files: Record<string, ArrayBuffer | Promise<ArrayBuffer>>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
     const [content, hierarchical] = await Promise.all([
-      OnnxModel.create(specOf(manifest, 'content_encoder', files.content_encoder), providers),
-      OnnxModel.create(specOf(manifest, 'hierarchical', files.hierarchical), providers),
+      Promise.resolve(files.content_encoder).then((bytes) => OnnxModel.create(specOf(manifest, 'content_encoder', bytes), providers)),
+      Promise.resolve(files.hierarchical).then((bytes) => OnnxModel.create(specOf(manifest, 'hierarchical', bytes), providers)),
     ]);
     return new ContentEncoder(manifest, content, hierarchical);
   }
@@ -84,6 +88,12 @@ export class ContentEncoder {
       for (let j = 1; j < classes; j++) if (post[row + j] > post[row + best]) best = j;
       return best;
     });
+  }
+
+  /** Each frame's speech probability (voice-activity.ts): 1 - P(SIL) at its content position, 0 where its `level` (RMS) is too low. */
+  speechProbability(post: Float32Array, melIndex: number[], r: ContentRange, level: number[]): Float32Array {
+    if (this.silence < 0) return new Float32Array(melIndex.length).fill(1);
+    return speechProbabilities(post, this.m.content_classes, this.silence, melIndex.map((k) => Math.floor(k / this.m.content_stride) - r.lo), level);
   }
 
   /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */

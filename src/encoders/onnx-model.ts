@@ -41,10 +41,11 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     // ort/ is the sibling of the folder holding this code (assets/ for the app, lib/ for the library),
     // so an embedding page finds them wherever it hosts the build; in dev, at the server root. The version in
     // the path lets a browser keep them for good (docs/embedding.md).
-    const folder = `ort/${ort.env.versions.web}/`; // (not a literal URL, so Vite does not try to bundle it as an asset)
+    const folder = `ort/${ort.env.versions.web}/`;
+    const sibling = `../${folder}`; // (a variable: Vite would turn a template literal in new URL() into a glob of assets)
     ort.env.wasm.wasmPaths = import.meta.env.DEV
       ? new URL(`${import.meta.env.BASE_URL}${folder}`, globalThis.location?.href ?? 'file:///').href
-      : new URL(`../${folder}`, import.meta.url).href;
+      : new URL(sibling, import.meta.url).href;
     return ort;
   });
   return ortModules[build];

@@ -8,7 +8,7 @@
  *
  * Library code: no DOM.
  */
-import { loadArtefacts, type ArtefactOptions } from '../model/artefacts';
+import { fetchArtefacts, type ArtefactOptions } from '../model/artefacts';
 import type { Manifest } from '../model/manifest';
 import { parseSafetensors } from '../model/safetensors';
 import type { ExecutionProvider } from '../encoders/onnx-model';
@@ -22,6 +22,8 @@ import { DEFAULT_CHUNK_FRAMES, Pipeline } from './pipeline';
 import { StreamSession } from './stream';
 import { LiveSession, type LiveOptions } from './live';
 import { yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
+import { speechFound } from '../encoders/voice-activity';
+import { poseFrames } from '../pose/posing';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -64,18 +66,22 @@ export class TalkingFaceEngine {
   private constructor(private readonly pipeline: Pipeline) {}
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
-    const { manifest, template, files } = await loadArtefacts(options);
+    // Each ONNX session is created as soon as its file has arrived (the first one starts onnxruntime's download and
+    // compile), while the others are still on their way: the model is ready sooner than if every file were awaited first.
+    // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
+    const [support, { manifest, template, files }] = await Promise.all([detectWebGPU(), fetchArtefacts(options)]);
     const m = manifest.model.config;
-    const support = await detectWebGPU();
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
-    const weights = decoderWeights(parseSafetensors(files.decoder_weights).tensors, m, manifest.model.layer_norm_eps);
-    const [content, pose, decoders] = await Promise.all([
+    const decoders = Promise.all([template, files.decoder_weights]).then(([t, bytes]) => DecoderBackends.create(
+      decoderWeights(parseSafetensors(bytes).tensors, m, manifest.model.layer_norm_eps), t.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options));
+    const [content, pose, decoder, face] = await Promise.all([
       ContentEncoder.create(manifest, files, providers),
       PoseEncoder.create(manifest, files, providers),
-      DecoderBackends.create(weights, template.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options),
+      decoders,
+      template,
     ]);
-    return new TalkingFaceEngine(new Pipeline(manifest, template, content, pose, decoders));
+    return new TalkingFaceEngine(new Pipeline(manifest, face, content, pose, decoder));
   }
 
   get manifest(): Manifest {
@@ -144,6 +150,7 @@ export class TalkingFaceEngine {
     const pose = new Float32Array(F * 6);
     const unposed = options.unposed ? new Float32Array(F * n * 3) : undefined;
     const phones = new Uint8Array(F);
+    const speech = new Float32Array(F);
     const state = this.pipeline.newState();
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
@@ -154,10 +161,11 @@ export class TalkingFaceEngine {
       if (keep) vertices.set(out.vertices, f0 * n * 3);
       unposed?.set(out.unposed, f0 * n * 3);
       phones.set(out.phones, f0);
+      speech.set(out.speech, f0);
       options.onFrames?.(f0, out.vertices, out.pose);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed, phones };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, speech };
   }
 
   /**
@@ -197,6 +205,26 @@ export class TalkingFaceEngine {
     this.rest ??= this.animate(new Float32Array(this.manifest.audio.sample_rate), { unposed: true })
       .then((a) => a.unposed!.slice((a.frames - 1) * n3, a.frames * n3));
     return this.rest;
+  }
+
+  /** Whether a clip holds speech (encoders/voice-activity.ts): speech-like frames, and more than one steady sound. */
+  hasSpeech(animation: Animation): boolean {
+    return speechFound(animation.speech, animation.phones, animation.fps);
+  }
+
+  /**
+   * The face at rest on every frame of `animation` (its head poses kept), in place: for audio in which no speech
+   * was found (noise, music, a tone), which the model would otherwise mouth as if it were speech.
+   */
+  async holdRest(animation: Animation): Promise<void> {
+    const rest = await this.restFace();
+    const n3 = rest.length;
+    const mm = this.pipeline.mmPerUnit;
+    const offsets = new Float32Array(animation.frames * n3);
+    for (let f = 0; f < animation.frames; f++) for (let i = 0; i < n3; i++) offsets[f * n3 + i] = rest[i] * mm - this.pipeline.templateMm[i];
+    const posed = poseFrames(this.pipeline.templateMm, offsets, animation.pose, animation.frames, mm);
+    if (animation.vertices.length) animation.vertices.set(posed.vertices);
+    animation.unposed?.set(posed.unposed);
   }
 
   resetTimes(): void {

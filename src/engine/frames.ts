@@ -8,6 +8,8 @@ export interface Frames {
   pose: Float32Array;
   /** (count): the content class heard most at each frame (manifest.content_phones). */
   phones: Uint8Array;
+  /** (count): the probability that each frame is speech (encoders/voice-activity.ts). */
+  speech: Float32Array;
 }
 
 export interface Animation {
@@ -21,6 +23,8 @@ export interface Animation {
   unposed?: Float32Array;
   /** (frames): the content class the encoder heard most at each frame (names: manifest.content_phones). */
   phones: Uint8Array;
+  /** (frames): the probability that each frame is speech: 1 - P(silence) where the signal is loud enough (encoders/voice-activity.ts). */
+  speech: Float32Array;
 }
 
 /** Milliseconds spent in each stage since the last resetTimes(). */
@@ -41,15 +45,17 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
   const unposed = new Float32Array(count * per);
   const pose = new Float32Array(count * 6);
   const phones = new Uint8Array(count);
+  const speech = new Float32Array(count);
   let i = 0;
   for (const f of chunks) {
     vertices.set(f.vertices, i * per);
     unposed.set(f.unposed, i * per);
     pose.set(f.pose, i * 6);
     phones.set(f.phones, i);
+    speech.set(f.speech, i);
     i += f.count;
   }
-  return { fps, frames: count, vertices, pose, unposed, phones };
+  return { fps, frames: count, vertices, pose, unposed, phones, speech };
 }
 
 /** Resolve on a new task (not a microtask): lets the browser handle input, rendering and timers. */

@@ -11,6 +11,7 @@ import type { ContentEncoder } from '../encoders/content';
 import type { PoseEncoder, PoseState } from '../encoders/pose';
 import type { DecoderBackends } from './backends';
 import { poseFrames } from '../pose/posing';
+import { levelAt } from '../encoders/voice-activity';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
 import type { Frames, StageTimes } from './frames';
 
@@ -87,6 +88,8 @@ export class Pipeline {
     const post = await this.content.posteriors(mel, range);
     const windows = this.content.windows(post, melIndex, range, K);
     const phones = this.content.heardPhones(post, melIndex, range);
+    const level = melIndex.map((k) => levelAt(samples, offset, k * a.hop, a.frame_size));
+    const speech = this.content.speechProbability(post, melIndex, range, level);
     this.times.content += performance.now() - t;
 
     t = performance.now();
@@ -113,6 +116,6 @@ export class Pipeline {
     t = performance.now();
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
-    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones };
+    return { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones, speech };
   }
 }

@@ -8,6 +8,7 @@ const chunk = (first: number, count: number, n: number): Frames => ({
   unposed: Float32Array.from({ length: count * n * 3 }, (_, i) => -(first * n * 3 + i)),
   pose: Float32Array.from({ length: count * 6 }, (_, i) => first * 6 + i),
   phones: Uint8Array.from({ length: count }, (_, i) => first + i),
+  speech: Float32Array.from({ length: count }, (_, i) => (first + i) / 100),
 });
 
 describe('joinFrames', () => {
@@ -19,6 +20,7 @@ describe('joinFrames', () => {
     expect(Array.from(a.unposed!)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => -i));
     expect(Array.from(a.pose)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => i));
     expect(Array.from(a.phones)).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
+    expect(Array.from(a.speech, (p) => Math.round(p * 100))).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
   });
 
   it('no chunks make an empty animation', () => {

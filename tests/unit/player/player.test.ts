@@ -26,6 +26,7 @@ function animation(frames: number): Animation {
     unposed: Float32Array.from({ length: frames * 6 }, (_, i) => Math.floor(i / 6)),
     pose: Float32Array.from({ length: frames * 6 }, (_, i) => (i % 6 < 3 ? Math.floor(i / 6) : 10 * Math.floor(i / 6))),
     phones: new Uint8Array(frames),
+    speech: new Float32Array(frames),
   };
 }
 
