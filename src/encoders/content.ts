@@ -6,7 +6,8 @@
 import type { Manifest, ModelConstants } from '../model/manifest';
 import { contentWindows, softmaxRows } from './windows';
 import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
-import { speechProbabilities } from './voice-activity';
+import { melFlatness, speechProbabilities } from './voice-activity';
+import { melBandWidths } from '../audio/mel';
 
 /** Content frames [lo, hi) and the Mel frames [melLo, melHi) that compute them exactly. */
 export interface ContentRange {
@@ -90,10 +91,16 @@ export class ContentEncoder {
     });
   }
 
-  /** Each frame's speech probability (voice-activity.ts): 1 - P(SIL) at its content position, 0 where its `level` (RMS) is too low. */
-  speechProbability(post: Float32Array, melIndex: number[], r: ContentRange, level: number[]): Float32Array {
+  /**
+   * Each frame's speech probability (voice-activity.ts): 1 - P(SIL) at its content position, 0 where its `level`
+   * (RMS) is too low or its Mel frame (`mel`: frames r.melLo..r.melHi) is as flat as noise.
+   */
+  speechProbability(post: Float32Array, mel: Float32Array, melIndex: number[], r: ContentRange, level: number[]): Float32Array {
     if (this.silence < 0) return new Float32Array(melIndex.length).fill(1);
-    return speechProbabilities(post, this.m.content_classes, this.silence, melIndex.map((k) => Math.floor(k / this.m.content_stride) - r.lo), level);
+    const bands = this.manifest.audio.n_mels;
+    const widths = melBandWidths(this.manifest.audio);
+    const flatness = melIndex.map((k) => melFlatness(mel.subarray((k - r.melLo) * bands, (k - r.melLo + 1) * bands), widths));
+    return speechProbabilities(post, this.m.content_classes, this.silence, melIndex.map((k) => Math.floor(k / this.m.content_stride) - r.lo), level, flatness);
   }
 
   /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */

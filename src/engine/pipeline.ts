@@ -89,7 +89,7 @@ export class Pipeline {
     const windows = this.content.windows(post, melIndex, range, K);
     const phones = this.content.heardPhones(post, melIndex, range);
     const level = melIndex.map((k) => levelAt(samples, offset, k * a.hop, a.frame_size));
-    const speech = this.content.speechProbability(post, melIndex, range, level);
+    const speech = this.content.speechProbability(post, mel, melIndex, range, level);
     this.times.content += performance.now() - t;
 
     t = performance.now();

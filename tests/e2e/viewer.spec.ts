@@ -21,14 +21,14 @@ test.describe('the face viewer', () => {
     await test.info().attach('viewer.png', { body: shot, contentType: 'image/png' });
   });
 
-  test('finds the WebGPU adapter and says so in the status line', async ({ page }) => {
+  test('finds the WebGPU adapter and says so in the details', async ({ page }) => {
     const gpu = await page.evaluate(() => {
       const g = (globalThis as unknown as { talkingFace: { gpu: { available: boolean; info: { architecture: string } | null } } }).talkingFace.gpu;
       return { available: g.available, architecture: g.info?.architecture };
     });
     expect(gpu.available).toBe(true);
     expect(gpu.architecture).toBe('swiftshader');
-    await expect(page.locator('#status')).toContainText('WebGPU adapter: google swiftshader');
+    await expect(page.locator('#details')).toContainText('WebGPU adapter: google swiftshader');
   });
 
   test('draws eyeballs and the inner-mouth backing', async ({ page }) => {

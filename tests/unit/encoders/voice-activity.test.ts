@@ -1,6 +1,6 @@
 /** The voice-activity check (src/encoders/voice-activity.ts): per-frame speech probability and the per-clip decision. */
 import { describe, expect, it } from 'vitest';
-import { levelAt, speechFound, speechProbabilities, SPEECH_LEVEL } from '../../../src/encoders/voice-activity';
+import { levelAt, melFlatness, speechFound, speechProbabilities, NOISE_FLATNESS, SPEECH_LEVEL } from '../../../src/encoders/voice-activity';
 
 describe('voice activity', () => {
   it('measures the level around a sample, within the samples held', () => {
@@ -9,10 +9,18 @@ describe('voice activity', () => {
     expect(levelAt(x, 2000, 500, 100)).toBe(0); // outside what is held
   });
 
-  it('takes 1 - P(silence), and nothing where the signal is too quiet', () => {
+  it('takes 1 - P(silence), and nothing where the signal is too quiet or as flat as noise', () => {
     const post = Float32Array.from([0.1, 0.9, 0.8, 0.2]); // two content frames, classes [phone, SIL]
-    const p = speechProbabilities(post, 2, 1, [0, 1, 1], [0.1, 0.1, SPEECH_LEVEL / 2]);
-    expect(Array.from(p, (v) => Number(v.toFixed(2)))).toEqual([0.1, 0.8, 0]);
+    const p = speechProbabilities(post, 2, 1, [0, 1, 1, 1], [0.1, 0.1, SPEECH_LEVEL / 2, 0.1], [0, 0, 0, 2 * NOISE_FLATNESS]);
+    expect(Array.from(p, (v) => Number(v.toFixed(2)))).toEqual([0.1, 0.8, 0, 0]);
+  });
+
+  it('measures spectral flatness per FFT bin: 1 for energy spread evenly, near 0 for one band', () => {
+    const widths = Float64Array.from([0, 2, 4, 8]); // an empty first filter is skipped
+    const even = Float32Array.from([5, Math.log1p(2), Math.log1p(4), Math.log1p(8)]);
+    expect(melFlatness(even, widths)).toBeCloseTo(1, 6);
+    const peaked = Float32Array.from([0, Math.log1p(1e4), 0, 0]);
+    expect(melFlatness(peaked, widths)).toBeLessThan(0.01);
   });
 
   it('finds speech in varied phones, not in silence or one steady sound', () => {
