@@ -84,8 +84,8 @@ const ENCODINGS: [token: string, suffix: string][] = [['br', '.br'], ['gzip', '.
 
 /**
  * Serve the files of the build under `root` (GET and HEAD): the precompressed copy the browser accepts, its
- * Cache-Control, an ETag (a 304 when it matches), and the cross-origin isolation headers. Anything else
- * (no such file, a Range request) goes on to the next middleware.
+ * Cache-Control, an ETag (a 304 when it matches), and the cross-origin isolation headers. A missing file is a 404;
+ * a missing page and a Range request go on to the next middleware.
  */
 export function serveBuild(root: string) {
   return (req: IncomingMessage, res: ServerResponse, next: () => void): void => {
@@ -93,7 +93,12 @@ export function serveBuild(root: string) {
     let path = decodeURIComponent((req.url ?? '/').split('?')[0]);
     if (path.endsWith('/')) path += 'index.html';
     const file = normalize(resolve(root, '.' + path));
-    if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) return next();
+    if (!file.startsWith(root + sep) || !existsSync(file) || !statSync(file).isFile()) {
+      if (!/\.\w+$/.test(path) || path.endsWith('.html')) return next(); // a page: the server's fallbacks
+      res.statusCode = 404; // a missing file (a model, a script) is missing, never the HTML of a fallback page
+      res.end(`not found: ${path}`);
+      return;
+    }
     const accept = String(req.headers['accept-encoding'] ?? '');
     const [encoding, suffix] = ENCODINGS.find(([token, sfx]) => new RegExp(`\\b${token}\\b`).test(accept) && existsSync(file + sfx)) ?? ['', ''];
     const served = file + suffix;
