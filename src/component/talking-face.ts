@@ -1,9 +1,6 @@
 /**
  * <talking-face>: the whole thing as one custom element (shadow DOM). docs/embedding.md.
- *
- *   <script type="module" src="/lib/talking-face.js"></script>
- *   <talking-face src="/hello.wav" autoplay></talking-face>
- *
+ *   <script type="module" src="/lib/talking-face.js"></script> <talking-face src="/hello.wav" autoplay></talking-face>
  * Attributes: model (manifest URL), template (template URL; must be the model's template), src (audio
  * URL to speak), backend (auto | cpu | webgpu), autoplay (speak src as soon as it is animated), live
  * (animate the microphone). Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame,
@@ -16,7 +13,7 @@ import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
-import { Player, audioNotes } from '../player/player';
+import { Player, audioNotes, SHORT_CLIP_SECONDS } from '../player/player';
 
 /** The model an element loads when it has no `model` attribute. */
 export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
@@ -38,7 +35,7 @@ export interface FrameDetail {
   /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
   inferenceMs?: number;
   latencyMs?: number;
-  /** Offline: seconds of audio per second of compute. */
+  /** Offline: seconds of audio per second of compute (none for a clip under SHORT_CLIP_SECONDS). */
   realTimeFactor?: number;
 }
 
@@ -184,25 +181,27 @@ export class TalkingFaceElement extends HTMLElement {
     }
     if (gen !== this.generation) return;
     const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
-    const notes = audioNotes(decoded.samples, seconds);
     const t0 = performance.now();
-    let animation: Animation;
+    let animation: Animation, computeMs: number, speech: boolean;
     try {
       animation = await engine.animate(decoded.samples, {
         unposed: true,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
+      computeMs = performance.now() - t0;
+      speech = engine.hasSpeech(animation);
+      if (!speech) await engine.holdRest(animation); // noise, music, a tone: the face at rest
     } catch (e) {
       throw this.fail('inference', `animation failed: ${(e as Error).message}`);
     }
     if (gen !== this.generation) return;
-    this.computeMs = performance.now() - t0;
-    this.audioSeconds = seconds;
+    const notes = audioNotes(decoded.samples, seconds, speech);
+    [this.computeMs, this.audioSeconds] = [computeMs, seconds];
     this.animation = animation;
     this.player?.load(animation, decoded.buffer);
     this.player?.show(0);
-    this.setStatus(`${animation.frames} frames, ${(this.audioSeconds / (this.computeMs / 1000)).toFixed(1)}x real time on ${engine.backend}` +
-      (notes.length ? ` (${notes.join('; ')})` : ''));
+    const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
+    this.setStatus(notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`);
     await this.player?.play(0);
   }
 
@@ -301,7 +300,8 @@ export class TalkingFaceElement extends HTMLElement {
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
       detail: {
         frame, time: frame / a.fps, mode: 'playback', backend: this.engine.backend,
-        inferenceMs: this.computeMs / a.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
+        inferenceMs: this.computeMs / a.frames,
+        realTimeFactor: this.audioSeconds < SHORT_CLIP_SECONDS ? undefined : this.audioSeconds / (this.computeMs / 1000),
       },
     }));
   }
