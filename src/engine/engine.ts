@@ -11,7 +11,7 @@
 import { fetchArtefacts, type ArtefactOptions } from '../model/artefacts';
 import type { Manifest } from '../model/manifest';
 import { parseSafetensors } from '../model/safetensors';
-import type { ExecutionProvider } from '../encoders/onnx-model';
+import { loadOrt, ortBuildFor, type ExecutionProvider } from '../encoders/onnx-model';
 import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
@@ -80,6 +80,7 @@ export class TalkingFaceEngine {
       PoseEncoder.create(manifest, files, providers),
       decoders,
       template,
+      loadOrt(ortBuildFor(providers)), // onnxruntime's script now, while the files arrive
     ]);
     return new TalkingFaceEngine(new Pipeline(manifest, face, content, pose, decoder));
   }
