@@ -1,6 +1,6 @@
 /**
  * npm run screenshots: the demo's main views, rendered in headless Chromium (SwiftShader WebGL), saved
- * to docs/screenshots/. Builds the app and serves it like the tests do.
+ * to docs/screenshots/. Builds the app and serves it like the tests do (on port 4192, or SCREENSHOTS_PORT).
  */
 import { chromium, type Page } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
@@ -10,7 +10,7 @@ import { fakeMicrophone } from '../playwright.config';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const OUT = resolve(ROOT, 'docs/screenshots');
-const PORT = 4192;
+const PORT = Number(process.env.SCREENSHOTS_PORT ?? 4192);
 const URL_ = `http://127.0.0.1:${PORT}`;
 
 async function ready(page: Page, attr: string, value: string): Promise<void> {
@@ -41,6 +41,10 @@ async function main(): Promise<void> {
     await page.locator('#scrub').fill('45');
     await page.screenshot({ path: resolve(OUT, 'sample.png') });
     await page.locator('#timeline').screenshot({ path: resolve(OUT, 'timeline.png') });
+    // The status line and, opened, the details under it (the decoder, the take's figures, E_vl).
+    await page.locator('#details summary').click();
+    await page.screenshot({ path: resolve(OUT, 'details.png') });
+    await page.locator('#details summary').click();
     await page.locator('#side-check').check();
     await page.locator('#arrows-check').check();
     await page.locator('#paint-select').selectOption('error');
