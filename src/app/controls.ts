@@ -94,6 +94,7 @@ export interface ControlActions {
 
 export function bindControls(a: ControlActions): void {
   ui.sampleSelect.addEventListener('change', () => {
+    a.unlockAudio(); // a choice is a gesture (by mouse or keyboard): the sample may play once animated
     if (ui.sampleSelect.value) a.openSample(ui.sampleSelect.value);
   });
   ui.arrowsCheck.addEventListener('change', () => a.setArrows(ui.arrowsCheck.checked));
@@ -112,7 +113,7 @@ export function bindControls(a: ControlActions): void {
   });
   ui.recordButton.addEventListener('click', () => a.toggleRecording());
   // Opening or dropping a file is a gesture: the audio output is unlocked then, so the take can play once animated.
-  for (const el of [ui.fileInput, ui.sampleSelect]) el.addEventListener('click', () => a.unlockAudio());
+  ui.fileInput.addEventListener('click', () => a.unlockAudio());
   ui.cancelButton.addEventListener('click', () => a.cancel());
   ui.playButton.addEventListener('click', () => a.togglePlay());
   ui.scrub.addEventListener('input', () => a.seek(Number(ui.scrub.value)));

@@ -6,9 +6,8 @@
 import { loadTemplate } from '../template/face-template';
 import { FaceView } from '../render/face-view';
 import { detectWebGPU } from '../gpu/capabilities';
-import { TalkingFaceEngine, type Animation, type Backend } from '../engine/engine';
+import { TalkingFaceEngine, type Backend } from '../engine/engine';
 import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
-import type { Manifest } from '../model/manifest';
 import { decodeAudio } from '../audio/decode';
 import { Player, audioNotes } from '../player/player';
 import { TakeView, type Take } from './take-view';
