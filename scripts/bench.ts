@@ -6,6 +6,7 @@
  *
  *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]     (BENCH_PORT=... to serve on another port than 4191)
  *   npm run bench -- --first-load-only                            (the first load alone, printed; nothing written)
+ *   npm run bench -- --first-load-only --first-load-url URL       (... of a page served elsewhere, e.g. an older build)
  */
 import { chromium } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
@@ -87,7 +88,7 @@ async function main(): Promise<void> {
       }
     }
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
-    const firstLoad = await measureFirstLoad(browser, `http://127.0.0.1:${PORT}/`);
+    const firstLoad = await measureFirstLoad(browser, opt('--first-load-url', `http://127.0.0.1:${PORT}/`), 5);
     if (firstLoadOnly) {
       printFirstLoad(firstLoad);
       await browser.close();
@@ -107,7 +108,9 @@ async function main(): Promise<void> {
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
     result.node = node;
     result.first_load = firstLoad;
-    result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
+    const os = await import('node:os');
+    // The load average says how busy the machine was (other work slows every figure here).
+    result.machine = { cores: os.cpus().length, load_average: os.loadavg(), bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
     mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
     writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
     print(result);
@@ -129,7 +132,8 @@ function print(r: Record<string, unknown>): void {
     console.log(`${name.padEnd(14)} ${f(v.wall_ms, 0).padStart(9)}   ${f(v.rtf, 2).padStart(17)}   ${f(v.first_frame_ms, 0).padStart(16)}   ${f(v.peak_heap_bytes / 1e6).padStart(14)}   ` +
       [s.mel, s.content, s.hierarchical, s.pose, s.decoder, s.posing].map((x) => f(x, 0)).join(' / '));
   }
-  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
+  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms (${f((r.model_load_transfer_bytes as number) / 2 ** 20, 2)} MiB transferred, onnxruntime ${r.ort_build} build), ` +
+    `model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
     `CPU decoder: ${r.cpu_decoder_kernel} on ${r.cpu_decoder_threads} thread(s)`);
   console.log(`streaming latency (sample in -> frame out) p50 ${f(r.stream_latency_ms as number, 0)} ms, p95 ${f(r.stream_latency_p95_ms as number, 0)} ms; ` +
     `of which look-ahead ${f(r.stream_look_ahead_ms as number, 0)} ms, pieces of ${f(r.stream_piece_ms as number, 0)} ms`);
