@@ -9,14 +9,6 @@ export class ModelLoadError extends Error {
   override name = 'ModelLoadError';
 }
 
-export interface ModelArtefacts {
-  manifest: Manifest;
-  manifestUrl: URL;
-  template: FaceTemplate;
-  /** The runtime files' bytes by manifest key (content_encoder, hierarchical, pose_conv, pose_lstm, decoder_weights). */
-  files: Record<string, ArrayBuffer>;
-}
-
 export interface ArtefactOptions {
   /** URL of models/manifest.json (default DEFAULT_MANIFEST_URL, against the page). */
   manifestUrl?: string | URL;
@@ -96,12 +88,4 @@ export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<Arr
     return t;
   });
   return { manifest, manifestUrl, template, files: Object.fromEntries(manifest.runtime_files.map((k) => [k, file(k)])) };
-}
-
-/** Everything the engine needs, fetched in parallel and checked. */
-export async function loadArtefacts(options: ArtefactOptions = {}): Promise<ModelArtefacts> {
-  const a = await fetchArtefacts(options);
-  const keys = a.manifest.runtime_files;
-  const [template, ...bytes] = await Promise.all([a.template, ...keys.map((k) => a.files[k])]);
-  return { manifest: a.manifest, manifestUrl: a.manifestUrl, template, files: Object.fromEntries(keys.map((k, i) => [k, bytes[i]])) };
 }
