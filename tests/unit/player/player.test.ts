@@ -3,7 +3,7 @@
  * the pose goes, the shape mapping, play / stop / end / loop, and the notes it writes about a clip's audio.
  */
 import { afterEach, beforeEach, describe, expect, it } from 'vitest';
-import { Player, audioNotes, LONG_CLIP_SECONDS } from '../../../src/player/player';
+import { Player, audioNotes, LONG_CLIP_SECONDS, SHORT_CLIP_SECONDS } from '../../../src/player/player';
 import type { FaceView } from '../../../src/render/face-view';
 import type { Animation } from '../../../src/engine/frames';
 
@@ -139,5 +139,13 @@ describe('audioNotes', () => {
     const clipped = Float32Array.from(speech, (v) => Math.max(-1, Math.min(1, v * 10)));
     expect(audioNotes(clipped, 1).join()).toMatch(/clipped/);
     expect(audioNotes(speech, LONG_CLIP_SECONDS + 1).join()).toMatch(/long clip/);
+  });
+
+  it('says when no speech was found (not for a silent clip, already said) and when a clip is very short', () => {
+    const sound = Float32Array.from({ length: 16000 }, (_, i) => 0.3 * Math.sin(i / 7));
+    expect(audioNotes(sound, 1, false)).toEqual(['no speech was found in it (noise, music or a tone?), so the mouth stays at rest']);
+    expect(audioNotes(new Float32Array(16000), 1, false).join()).not.toMatch(/no speech/);
+    expect(audioNotes(sound.subarray(0, 3200), 0.2).join()).toMatch(/very short clip \(0\.20 s\)/);
+    expect(audioNotes(sound, SHORT_CLIP_SECONDS)).toEqual([]);
   });
 });
