@@ -171,7 +171,7 @@ function openSample(name: string): Promise<void> {
   });
 }
 
-/** A take to show and play: its figures in the details, its most important note (if any) in the status line. */
+/** A take to show and play: its figures in the details, its most important note (if any) kept for the status line. */
 function setTake(t: Take, notes: string[] = []): Take {
   take = t;
   player.load(t.animation, t.buffer, takeView.drawn(t));
@@ -183,7 +183,6 @@ function setTake(t: Take, notes: string[] = []): Take {
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
   player.show(0);
-  tell(takeNote || `${t.name} is ready: press Play.`);
   return t;
 }
 
@@ -254,6 +253,7 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     const notes = audioNotes(done.samples, done.seconds, speech).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
     setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
+    tell(takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';
   } catch (err) {
     tell(`The recording could not be finished: ${(err as Error).message}`, true);
