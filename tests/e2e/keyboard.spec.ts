@@ -38,9 +38,11 @@ test('open, play, pause, scrub, orbit, zoom, step, record, stop and export by ke
   });
 
   // Open a file: Enter on "Open an audio file…" opens the chooser; the take then plays by itself.
+  // (Waiting for the chooser from before the first Tab: Playwright then intercepts it well before Enter.)
+  const chooser = page.waitForEvent('filechooser');
   await tabTo(page, '#file-input');
-  const [chooser] = await Promise.all([page.waitForEvent('filechooser'), page.keyboard.press('Enter')]);
-  await chooser.setFiles(SPEECH);
+  await page.keyboard.press('Enter');
+  await (await chooser).setFiles(SPEECH);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
   await expect(page.locator('#play-button')).toHaveText('Pause');
 
