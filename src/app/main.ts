@@ -140,8 +140,7 @@ async function animateAudio(e: TalkingFaceEngine, name: string, samples: Float32
     onProgress: (done, total) => showStatus(`Animating ${name}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
   });
   const computeMs = performance.now() - t0;
-  const speech = e.hasSpeech(animation);
-  if (!speech) await e.holdRest(animation);
+  const speech = await e.restUnlessSpeech(animation);
   return { animation, computeMs, notes: audioNotes(samples, seconds, speech) };
 }
 
@@ -248,8 +247,7 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
   try {
     const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));
     if (!done) return tell('The take was too short to animate. Press Record and speak for a moment.', true);
-    const speech = e.hasSpeech(done.animation);
-    if (!speech) await e.holdRest(done.animation);
+    const speech = await e.restUnlessSpeech(done.animation);
     const notes = audioNotes(done.samples, done.seconds, speech).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
     setTake({ ...done, name: 'Recording', backend: e.backend }, notes);

@@ -189,8 +189,7 @@ export class TalkingFaceElement extends HTMLElement {
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
       computeMs = performance.now() - t0;
-      speech = engine.hasSpeech(animation);
-      if (!speech) await engine.holdRest(animation); // noise, music, a tone: the face at rest
+      speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
     } catch (e) {
       throw this.fail('inference', `animation failed: ${(e as Error).message}`);
     }

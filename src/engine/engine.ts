@@ -214,9 +214,17 @@ export class TalkingFaceEngine {
   }
 
   /**
-   * The face at rest on every frame of `animation` (its head poses kept), in place: for audio in which no speech
-   * was found (noise, music, a tone), which the model would otherwise mouth as if it were speech.
+   * Whether `animation` holds speech (hasSpeech); where it does not (noise, music, a tone, which the model would
+   * otherwise mouth as if it were speech), its face is held at rest first (holdRest). What the demo and
+   * <talking-face> do with every offline take.
    */
+  async restUnlessSpeech(animation: Animation): Promise<boolean> {
+    const speech = this.hasSpeech(animation);
+    if (!speech) await this.holdRest(animation);
+    return speech;
+  }
+
+  /** The face at rest on every frame of `animation` (its head poses kept), in place. */
   async holdRest(animation: Animation): Promise<void> {
     const rest = await this.restFace();
     const n3 = rest.length;
