@@ -1,40 +1,35 @@
 import { defineConfig, defaultClientConditions, type Plugin } from 'vite';
-import { createReadStream, existsSync, statSync, cpSync } from 'node:fs';
+import { createReadStream, existsSync, statSync, cpSync, readFileSync } from 'node:fs';
 import { resolve, normalize, sep, extname } from 'node:path';
+import { ISOLATION_HEADERS, MIME, precompress, serveBuild } from './scripts/hosting';
 
 /**
- * Cross-origin isolation lets onnxruntime-web use threads (SharedArrayBuffer).
+ * Cross-origin isolation (ISOLATION_HEADERS) lets onnxruntime-web use threads (SharedArrayBuffer).
  * An embedding page may not set these; the library then runs single-threaded.
  */
-const isolationHeaders = {
-  'Cross-Origin-Opener-Policy': 'same-origin',
-  'Cross-Origin-Embedder-Policy': 'require-corp',
-};
-
 const MODELS_DIR = resolve(import.meta.dirname, 'models');
-// onnxruntime-web's runtime (wasm + its Emscripten glue), served as plain files at /ort/ and loaded through
-// ort.env.wasm.wasmPaths: its thread workers then import that glue, never a bundled chunk of the app.
+// onnxruntime-web's runtime (wasm + its Emscripten glue), served as plain files at /ort/<version>/ and loaded through
+// ort.env.wasm.wasmPaths: its thread workers then import that glue, never a bundled chunk of the app. The version in
+// the path lets browsers keep them for a year (scripts/hosting.ts). The plain WebAssembly build is what the encoders
+// use on the wasm provider; the JSEP build (WebGPU-capable, twice the size) only where the WebGPU provider is used.
 const ORT_DIST = resolve(import.meta.dirname, 'node_modules/onnxruntime-web/dist');
-const ORT_FILES = ['ort-wasm-simd-threaded.jsep.mjs', 'ort-wasm-simd-threaded.jsep.wasm', 'ort-wasm-simd-threaded.mjs', 'ort-wasm-simd-threaded.wasm'];
-const MIME: Record<string, string> = {
-  '.json': 'application/json',
-  '.onnx': 'application/octet-stream',
-  '.bin': 'application/octet-stream',
-  '.safetensors': 'application/octet-stream',
-  '.mjs': 'text/javascript',
-  '.wasm': 'application/wasm',
-};
+const ORT_VERSION = JSON.parse(readFileSync(resolve(ORT_DIST, '../package.json'), 'utf8')).version as string;
+const ORT_FILES = ['ort-wasm-simd-threaded.mjs', 'ort-wasm-simd-threaded.wasm', 'ort-wasm-simd-threaded.jsep.mjs', 'ort-wasm-simd-threaded.jsep.wasm'];
 
-/** Serve models/ at /models/ in dev and preview, and copy it into the build: the exported artefacts live in one place. */
+/**
+ * Serve models/ at /models/ and onnxruntime-web's files at /ort/<version>/ in dev, copy both into the build, and
+ * serve the build in preview as a static host should (scripts/hosting.ts: precompressed files, cache headers).
+ */
 function modelsDir(): Plugin {
-  const middleware = (req: { url?: string }, res: import('node:http').ServerResponse, next: () => void) => {
+  const devMiddleware = (req: { url?: string }, res: import('node:http').ServerResponse, next: () => void) => {
     const url = decodeURIComponent((req.url ?? '').split('?')[0]);
+    const ortPrefix = `/ort/${ORT_VERSION}/`;
     let file: string;
     if (url.startsWith('/models/')) {
       file = normalize(resolve(MODELS_DIR, '.' + url.slice('/models'.length)));
       if (!file.startsWith(MODELS_DIR + sep)) file = '';
-    } else if (url.startsWith('/ort/') && ORT_FILES.includes(url.slice('/ort/'.length))) {
-      file = resolve(ORT_DIST, url.slice('/ort/'.length));
+    } else if (url.startsWith(ortPrefix) && ORT_FILES.includes(url.slice(ortPrefix.length))) {
+      file = resolve(ORT_DIST, url.slice(ortPrefix.length));
     } else return next();
     if (!file || !existsSync(file) || !statSync(file).isFile()) {
       res.statusCode = 404;
@@ -42,7 +37,7 @@ function modelsDir(): Plugin {
       return;
     }
     res.setHeader('Content-Type', MIME[extname(file)] ?? 'application/octet-stream');
-    for (const [k, v] of Object.entries(isolationHeaders)) res.setHeader(k, v);
+    for (const [k, v] of Object.entries(ISOLATION_HEADERS)) res.setHeader(k, v);
     createReadStream(file).pipe(res);
   };
   let outDir = 'dist';
@@ -52,14 +47,15 @@ function modelsDir(): Plugin {
       outDir = resolve(config.root, config.build.outDir);
     },
     configureServer(server) {
-      server.middlewares.use(middleware);
+      server.middlewares.use(devMiddleware);
     },
     configurePreviewServer(server) {
-      server.middlewares.use(middleware);
+      server.middlewares.use(serveBuild(outDir));
     },
     closeBundle() {
-      cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true });
-      for (const f of ORT_FILES) cpSync(resolve(ORT_DIST, f), resolve(outDir, 'ort', f));
+      cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true, preserveTimestamps: true });
+      for (const f of ORT_FILES) cpSync(resolve(ORT_DIST, f), resolve(outDir, 'ort', ORT_VERSION, f), { preserveTimestamps: true });
+      precompress(outDir);
     },
   };
 }
@@ -74,8 +70,8 @@ export default defineConfig(({ mode }) => {
   const page = (name: string) => resolve(import.meta.dirname, name);
   return {
     plugins: [modelsDir()],
-    server: { headers: isolationHeaders, port: 5173, strictPort: false },
-    preview: { headers: isolationHeaders, port: 4173, strictPort: false },
+    server: { headers: ISOLATION_HEADERS, port: 5173, strictPort: false },
+    preview: { headers: ISOLATION_HEADERS, port: 4173, strictPort: false },
     build: {
       target: 'es2022',
       sourcemap: true,

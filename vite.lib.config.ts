@@ -1,6 +1,7 @@
 import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
+import { precompress } from './scripts/hosting';
 
 /**
  * The library build: dist/lib/talking-face.js (ES module) defines <talking-face> and exports the API
@@ -27,6 +28,7 @@ export default defineConfig({
       name: 'talking-face-examples',
       closeBundle() {
         cpSync(resolve(import.meta.dirname, 'examples'), resolve(import.meta.dirname, 'dist/examples'), { recursive: true });
+        for (const dir of ['dist/lib', 'dist/examples']) precompress(resolve(import.meta.dirname, dir));
       },
     },
   ],

@@ -40,6 +40,12 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   let t = now();
   const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
   result.model_load_ms = now() - t;
+  // What loading the engine fetched (this page's own requests; the decoder workers' scripts are not seen here), and
+  // which onnxruntime build: the plain WebAssembly one unless the WebGPU provider is used (issue 18).
+  const fetched = (performance.getEntriesByType('resource') as PerformanceResourceTiming[]).filter((r) => r.startTime >= t);
+  result.model_load_files = Object.fromEntries(fetched.map((r) => [new URL(r.name).pathname, { transfer_bytes: r.transferSize, body_bytes: r.decodedBodySize }]));
+  result.model_load_transfer_bytes = fetched.reduce((sum, r) => sum + r.transferSize, 0);
+  result.ort_build = fetched.some((r) => r.name.includes('.jsep.')) ? 'jsep' : 'wasm';
   const rate = engine.manifest.audio.sample_rate;
   const wav = await decodeAudio(wavBytes, rate);
   // The head on screen (dev/render-bench.ts): 3 s of speech drawn frame by frame.

@@ -1,12 +1,13 @@
 /**
  * npm run bench: the engine's speed and memory on this machine, in headless Chromium.
- * Builds the app, serves it, opens dev/bench.html, and writes docs/results/bench.json plus a table.
+ * Builds the app, serves it, measures the demo's first load (bytes per file, time to ready: scripts/first-load.ts),
+ * opens dev/bench.html, and writes docs/results/bench.json plus a table.
  * WebGPU here is SwiftShader (software): its figures are reported, not GPU figures.
  *
- *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]
- *   npm run bench -- --render-only    # only the head's render benchmark, merged into the existing bench.json
- *
- * BENCH_PORT sets the preview server's port (default 4191), for several checkouts benchmarking at once.
+ *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]     (BENCH_PORT=... to serve on another port than 4191)
+ *   npm run bench -- --render-only                                (only the head's render benchmark, merged into the existing bench.json)
+ *   npm run bench -- --first-load-only                            (the first load alone, printed; nothing written)
+ *   npm run bench -- --first-load-only --first-load-url URL       (... of a page served elsewhere, e.g. an older build)
  */
 import { chromium } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
@@ -20,6 +21,7 @@ import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
+import { measureFirstLoad, printFirstLoad, type FirstLoad } from './first-load';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -70,7 +72,8 @@ async function nodeBench(): Promise<Record<string, number | string>> {
 }
 
 async function main(): Promise<void> {
-  const node = await nodeBench();
+  const firstLoadOnly = process.argv.includes('--first-load-only');
+  const node = firstLoadOnly ? {} : await nodeBench();
   if (process.argv.includes('--node-only')) {
     console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
     return;
@@ -87,6 +90,12 @@ async function main(): Promise<void> {
       }
     }
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
+    const firstLoad = await measureFirstLoad(browser, opt('--first-load-url', `http://127.0.0.1:${PORT}/`), 5);
+    if (firstLoadOnly) {
+      printFirstLoad(firstLoad);
+      await browser.close();
+      return;
+    }
     const page = await browser.newPage();
     page.on('pageerror', (e) => console.error(`page error: ${e.message}`));
     await page.goto(`http://127.0.0.1:${PORT}/dev/bench.html`);
@@ -109,7 +118,10 @@ async function main(): Promise<void> {
       return;
     }
     result.node = node;
-    result.machine = { cores: (await import('node:os')).cpus().length, bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
+    result.first_load = firstLoad;
+    const os = await import('node:os');
+    // The load average says how busy the machine was (other work slows every figure here).
+    result.machine = { cores: os.cpus().length, load_average: os.loadavg(), bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
     mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
     writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
     print(result);
@@ -131,7 +143,8 @@ function print(r: Record<string, unknown>): void {
     console.log(`${name.padEnd(14)} ${f(v.wall_ms, 0).padStart(9)}   ${f(v.rtf, 2).padStart(17)}   ${f(v.first_frame_ms, 0).padStart(16)}   ${f(v.peak_heap_bytes / 1e6).padStart(14)}   ` +
       [s.mel, s.content, s.hierarchical, s.pose, s.decoder, s.posing].map((x) => f(x, 0)).join(' / '));
   }
-  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms, model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
+  console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms (${f((r.model_load_transfer_bytes as number) / 2 ** 20, 2)} MiB transferred, onnxruntime ${r.ort_build} build), ` +
+    `model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
     `CPU decoder: ${r.cpu_decoder_kernel} on ${r.cpu_decoder_threads} thread(s)`);
   console.log(`streaming latency (sample in -> frame out) p50 ${f(r.stream_latency_ms as number, 0)} ms, p95 ${f(r.stream_latency_p95_ms as number, 0)} ms; ` +
     `of which look-ahead ${f(r.stream_look_ahead_ms as number, 0)} ms, pieces of ${f(r.stream_piece_ms as number, 0)} ms`);
@@ -140,6 +153,7 @@ function print(r: Record<string, unknown>): void {
   console.log(`Node: Mel ${f(nd.mel_ms_per_audio_second)} ms per audio second (Meyda.extract per frame: ${f(nd.mel_meyda_extract_ms_per_audio_second)}); ` +
     `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel} (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
   printRender(r.render as Record<string, number>);
+  printFirstLoad(r.first_load as FirstLoad);
   console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
 }
 

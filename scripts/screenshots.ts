@@ -1,6 +1,6 @@
 /**
  * npm run screenshots: the demo's main views, rendered in headless Chromium (SwiftShader WebGL), saved
- * to docs/screenshots/. Builds the app and serves it like the tests do (SCREENSHOTS_PORT, default 4192).
+ * to docs/screenshots/. Builds the app and serves it like the tests do (on port 4192, or SCREENSHOTS_PORT).
  * The head: front, three-quarter and profile at rest, the mouth open on a vowel, the lips closed on /m/, idle.
  */
 import { chromium, type Browser, type Page } from '@playwright/test';
@@ -99,6 +99,10 @@ async function main(): Promise<void> {
     await page.locator('#scrub').fill('45');
     await page.screenshot({ path: resolve(OUT, 'sample.png') });
     await page.locator('#timeline').screenshot({ path: resolve(OUT, 'timeline.png') });
+    // The status line and, opened, the details under it (the decoder, the take's figures, E_vl).
+    await page.locator('#details summary').click();
+    await page.screenshot({ path: resolve(OUT, 'details.png') });
+    await page.locator('#details summary').click();
     await page.locator('#side-check').check();
     await page.locator('#arrows-check').check();
     await page.locator('#paint-select').selectOption('error');

@@ -13,7 +13,11 @@ export const ui = {
   loopCheck: $<HTMLInputElement>('loop-check'),
   scrub: $<HTMLInputElement>('scrub'),
   timeLabel: $<HTMLOutputElement>('time-label'),
-  clipInfo: $<HTMLSpanElement>('clip-info'),
+  clipInfo: $<HTMLParagraphElement>('clip-info'),
+  setupInfo: $<HTMLParagraphElement>('setup-info'),
+  takeInfo: $<HTMLParagraphElement>('take-info'),
+  exportInfo: $<HTMLParagraphElement>('export-info'),
+  announcer: $<HTMLParagraphElement>('announce'),
   sampleSelect: $<HTMLSelectElement>('sample-select'),
   arrowsCheck: $<HTMLInputElement>('arrows-check'),
   paintSelect: $<HTMLSelectElement>('paint-select'),
@@ -29,9 +33,39 @@ export const ui = {
   timeline: $<HTMLCanvasElement>('timeline'),
 };
 
+/** The status line: one short sentence of what happened and what to do next (the full text also on hover). */
 export function showStatus(text: string, isError = false): void {
   ui.status.textContent = text;
+  ui.status.title = text;
   ui.status.classList.toggle('error', isError);
+}
+
+let announced = '';
+
+/** Tell screen readers of a change of state, once: the live region hears of ready, playing, recording, errors, never of progress. */
+export function announce(text: string): void {
+  if (text === announced) return;
+  announced = text;
+  ui.announcer.textContent = text;
+}
+
+/** A change of state: the status line says it and the live region announces it. */
+export function tell(text: string, isError = false): void {
+  showStatus(text, isError);
+  announce(text);
+}
+
+/** Fix a button's width to that of its widest label (data-labels="Play|Pause"), so changing its label moves nothing. */
+export function lockWidth(button: HTMLButtonElement): void {
+  const labels = (button.dataset.labels ?? '').split('|');
+  const shown = button.textContent;
+  let widest = 0;
+  for (const label of labels) {
+    button.textContent = label;
+    widest = Math.max(widest, button.getBoundingClientRect().width);
+  }
+  button.textContent = shown;
+  button.style.minWidth = `${Math.ceil(widest)}px`;
 }
 
 /** Show a legend line (HTML: it may hold the colour ramp), or hide it with null. */
@@ -47,8 +81,7 @@ export interface ControlActions {
   cancel(): void;
   togglePlay(): void;
   seek(frame: number): void;
-  step(delta: number): void;
-  hasTake(): boolean;
+  unlockAudio(): void;
   setLoop(on: boolean): void;
   setArrows(on: boolean): void;
   repaint(): void;
@@ -64,6 +97,7 @@ export interface ControlActions {
 
 export function bindControls(a: ControlActions): void {
   ui.sampleSelect.addEventListener('change', () => {
+    a.unlockAudio(); // a choice is a gesture (by mouse or keyboard): the sample may play once animated
     if (ui.sampleSelect.value) a.openSample(ui.sampleSelect.value);
   });
   ui.arrowsCheck.addEventListener('change', () => a.setArrows(ui.arrowsCheck.checked));
@@ -82,21 +116,12 @@ export function bindControls(a: ControlActions): void {
     ui.fileInput.value = '';
   });
   ui.recordButton.addEventListener('click', () => a.toggleRecording());
+  // Opening or dropping a file is a gesture: the audio output is unlocked then, so the take can play once animated.
+  ui.fileInput.addEventListener('click', () => a.unlockAudio());
   ui.cancelButton.addEventListener('click', () => a.cancel());
   ui.playButton.addEventListener('click', () => a.togglePlay());
   ui.scrub.addEventListener('input', () => a.seek(Number(ui.scrub.value)));
   ui.backendSelect.addEventListener('change', () => a.setBackend(ui.backendSelect.value));
-  document.addEventListener('keydown', (ev) => {
-    // Space plays/pauses and arrows step frames when the viewer has focus.
-    if (document.activeElement !== ui.canvas || !a.hasTake()) return;
-    if (ev.key === ' ') {
-      ev.preventDefault();
-      a.togglePlay();
-    } else if (ev.key === 'ArrowRight' || ev.key === 'ArrowLeft') {
-      ev.preventDefault();
-      a.step(ev.key === 'ArrowRight' ? 1 : -1);
-    }
-  });
   ui.stage.addEventListener('dragover', (e) => {
     e.preventDefault();
     ui.stage.classList.add('dragging');
@@ -111,6 +136,7 @@ export function bindControls(a: ControlActions): void {
     ui.stage.classList.remove('dragging');
     ui.dropHint.hidden = true;
     const file = e.dataTransfer?.files?.[0];
+    a.unlockAudio();
     if (file) a.openFile(file);
   });
 }

@@ -3,21 +3,21 @@
  * an audio file the visitor opens or drops, a sample clip, or the microphone live while they speak; and plays
  * the take back with the face in sync (play, pause, scrub, loop) through the shared Player.
  */
-import { loadTemplate, type FaceTemplate } from '../template/face-template';
+import { loadTemplate } from '../template/face-template';
 import { FaceView } from '../render/face-view';
 import { detectWebGPU } from '../gpu/capabilities';
-import { TalkingFaceEngine, type Animation, type Backend } from '../engine/engine';
+import { TalkingFaceEngine, type Backend } from '../engine/engine';
 import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
-import type { Manifest } from '../model/manifest';
 import { decodeAudio } from '../audio/decode';
 import { Player, audioNotes } from '../player/player';
-import { simdUnavailable } from '../attention/simd-kernel';
 import { TakeView, type Take } from './take-view';
 import { Recording } from './recording';
-import { fetchSample, fetchSampleIndex, type SampleIndex } from './samples';
+import { fetchSample, fillSampleSelect, type SampleIndex } from './samples';
+import { setupDetails, decoderDetails, takeDetails } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
-import { ui, showStatus, bindControls } from './controls';
+import { ui, showStatus, tell, announce, lockWidth, bindControls } from './controls';
+import { bindKeys } from './keyboard';
 
 let view: FaceView;
 let player: Player;
@@ -29,6 +29,9 @@ let sampleIndex: SampleIndex | null = null;
 let busy: AbortController | null = null;
 let recording: Recording | null = null;
 let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
+/** The current take's most important note about its audio (silent, no speech, clipped, short), or ''. */
+let takeNote = '';
+let recordPending = false;
 
 function publish(): void {
   Object.assign(globalThis, {
@@ -40,49 +43,55 @@ function publish(): void {
   });
 }
 
-/** The manifest if it can be read (its error otherwise), and the face template it names (the default one without it). */
-async function loadFace(): Promise<{ template: FaceTemplate; manifest: { manifest: Manifest; manifestUrl: URL } | Error }> {
-  const manifest = await fetchManifest(undefined).catch((e: Error) => e);
-  const url = manifest instanceof Error ? DEFAULT_TEMPLATE_URL : templateUrlOf(manifest.manifest, manifest.manifestUrl);
-  return { template: await loadTemplate(url), manifest };
-}
-
+/**
+ * Start the face and the model together: the template, the model's files and onnxruntime arrive in parallel, and
+ * each ONNX session is created as soon as its file is in (engine.ts), while the face is being drawn.
+ */
 async function start(): Promise<void> {
-  const [{ template, manifest }, gpu] = await Promise.all([loadFace(), detectWebGPU()]);
+  const gpuReady = detectWebGPU();
+  const manifest = fetchManifest(undefined).catch((e: Error) => e);
+  const template = manifest.then((m) => loadTemplate(m instanceof Error ? DEFAULT_TEMPLATE_URL : templateUrlOf(m.manifest, m.manifestUrl)));
+  const engineReady = manifest.then((m) => {
+    if (m instanceof Error) throw m;
+    return TalkingFaceEngine.load({ ...m, template });
+  });
+  // Deliberate: the outcome is read below (await engineReady); this only keeps an early failure from being "unhandled".
+  engineReady.catch(() => undefined); // read by the await below
+  const [face, gpu] = await Promise.all([template, gpuReady]);
   lastGpu = gpu;
-  view = new FaceView(ui.canvas, template);
-  player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => (ui.playButton.textContent = 'Play') });
+  view = new FaceView(ui.canvas, face);
+  player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });
   takeView = new TakeView(view);
   publish();
-  const base = `Face: ${template.id} (${template.vertexCount} vertices). ` +
-    (gpu.available ? `WebGPU adapter: ${gpu.description}.` : `WebGPU: none (${gpu.description}); the CPU path will be used.`);
-  showStatus(`${base} Loading the model…`);
+  ui.setupInfo.textContent = setupDetails(face, gpu);
+  showStatus('Loading the model…');
   document.body.dataset.ready = 'true';
   try {
-    if (manifest instanceof Error) throw manifest;
-    engine = await TalkingFaceEngine.load({ ...manifest, template });
+    engine = await engineReady;
     player.unitsPerMm = engine.unitsPerMm;
     autoBackend = engine.backend;
     if (!gpu.available) ui.backendSelect.querySelector<HTMLOptionElement>('option[value="webgpu"]')!.disabled = true;
     publish();
-    showStatus(`${base} Model ${engine.manifest.model.name} ready. Decoder: ${engine.backend} (${engine.backendReason}; CPU decoder: ${engine.cpuKernel === 'wasm-simd' ? 'WebAssembly SIMD' : `JavaScript (no SIMD: ${simdUnavailable || 'unavailable'})`} on ${engine.cpuThreads} thread${engine.cpuThreads > 1 ? 's' : ''}). Open or drop an audio file, or record.`);
+    ui.setupInfo.textContent += ` Model ${engine.manifest.model.name}. ${decoderDetails(engine)}`;
+    tell('Ready: open or drop an audio file, choose a sample, or press Record.');
     document.body.dataset.engine = 'ready';
-    void loadSamples();
+    void fillSampleSelect(ui.sampleSelect).then((index) => (sampleIndex = index));
     engine.restFace().then(
       (rest) => {
         view.setRestFace(rest); // the mouth closed at rest, not the opened template
         document.body.dataset.rest = 'shown';
       },
-      (err: Error) => showStatus(`The face at rest could not be computed: ${err.message}`, true),
+      (err: Error) => tell(`The face at rest could not be computed: ${err.message}`, true),
     );
   } catch (e) {
-    showStatus(`${base} The model could not be loaded: ${(e as Error).message}. The face can still be viewed.`, true);
+    ui.setupInfo.textContent += ` The model could not be loaded: ${(e as Error).message}.`;
+    tell('The model could not be loaded. The face can still be viewed; reload the page to try again (Details says why).', true);
     document.body.dataset.engine = 'error';
   }
 }
 
 function needEngine(): TalkingFaceEngine | null {
-  if (!engine) showStatus('The model is not loaded, so audio cannot be animated. Reload the page to try again.', true);
+  if (!engine) tell('The model is not loaded, so audio cannot be animated. Reload the page to try again.', true);
   return engine;
 }
 
@@ -92,7 +101,7 @@ function setBusy(controller: AbortController | null): void {
   ui.recordButton.disabled = Boolean(controller);
 }
 
-/** Animate `samples` under a cancellable busy state; `label` names it in the progress line. */
+/** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>): Promise<void> {
   const e = needEngine();
   if (!e || recording) return;
@@ -100,15 +109,19 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   stopPlayback();
   const controller = new AbortController();
   setBusy(controller);
+  announce(`Animating ${label}…`);
   try {
     const t = await run(e, controller.signal);
-    if (t) document.body.dataset.take = 'ready';
+    if (t) {
+      document.body.dataset.take = 'ready';
+      play();
+    }
   } catch (err) {
     if (controller.signal.aborted) {
-      showStatus(`Stopped animating ${label}. Open another file or record.`);
+      tell(`Stopped animating ${label}. Open another file or record.`);
       document.body.dataset.take = take ? 'ready' : 'cancelled';
     } else {
-      showStatus(`Could not ${label === 'the sample' ? 'open the sample' : `animate ${label}`}: ${(err as Error).message}`, true);
+      tell(`Could not ${label === 'the sample' ? 'open the sample' : `animate ${label}`}: ${(err as Error).message}`, true);
       document.body.dataset.take = 'error';
     }
   } finally {
@@ -116,21 +129,29 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   }
 }
 
+/** Animate decoded audio with progress in the status line; where no speech is found the face stays at rest. */
+async function animateAudio(e: TalkingFaceEngine, name: string, samples: Float32Array, seconds: number, signal: AbortSignal) {
+  const early = audioNotes(samples, seconds);
+  e.resetTimes();
+  const t0 = performance.now();
+  const animation = await e.animate(samples, {
+    unposed: true,
+    signal,
+    onProgress: (done, total) => showStatus(`Animating ${name}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
+  });
+  const computeMs = performance.now() - t0;
+  const speech = await e.restUnlessSpeech(animation);
+  return { animation, computeMs, notes: audioNotes(samples, seconds, speech) };
+}
+
 function animateFile(file: File): Promise<void> {
   return animateTake(file.name, async (e, signal) => {
     showStatus(`Decoding ${file.name}…`);
     const audio = await decodeAudio(file, e.manifest.audio.sample_rate);
     const src = audio.source;
-    const notes = audioNotes(audio.samples, src.seconds);
-    ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}`;
-    e.resetTimes();
-    const t0 = performance.now();
-    const animation = await e.animate(audio.samples, {
-      unposed: true,
-      signal,
-      onProgress: (done, total) => showStatus(`Animating ${file.name}: frame ${done} of ${total} (${Math.round((100 * done) / total)}%)…` + (notes.length ? ` Note: ${notes.join('; ')}.` : '')),
-    });
-    return setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: file.name, seconds: src.seconds, computeMs: performance.now() - t0, backend: e.backend }, notes);
+    ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
+    const { animation, computeMs, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
+    return setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
   });
 }
 
@@ -141,44 +162,28 @@ function openSample(name: string): Promise<void> {
     showStatus(`Loading the sample "${c.text}"…`);
     const { audio: bytes, truth } = await fetchSample(c, view.template.vertexCount, e.unitsPerMm);
     const audio = await decodeAudio(bytes, e.manifest.audio.sample_rate);
-    e.resetTimes();
-    const t0 = performance.now();
-    const animation = await e.animate(audio.samples, { unposed: true, signal, onProgress: (done, total) => showStatus(`Animating the sample: frame ${done} of ${total}…`) });
-    ui.clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}"`;
-    const t = setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: c.name, seconds: c.seconds, computeMs: performance.now() - t0, backend: e.backend, truth });
-    showStatus(`${ui.status.textContent} E_vl on this clip: ${takeView.lipError(t, e).toFixed(2)} mm.`);
+    ui.clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}".`;
+    const { animation, computeMs, notes } = await animateAudio(e, 'the sample', audio.samples, c.seconds, signal);
+    const t = setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: c.name, seconds: c.seconds, computeMs, backend: e.backend, truth }, notes);
+    ui.takeInfo.textContent += ` E_vl on this clip: ${takeView.lipError(t, e).toFixed(2)} mm.`;
     return t;
   });
 }
 
+/** A take to show and play: its figures in the details, its most important note (if any) kept for the status line. */
 function setTake(t: Take, notes: string[] = []): Take {
   take = t;
   player.load(t.animation, t.buffer, takeView.drawn(t));
   publish();
-  const perFrame = t.computeMs / t.animation.frames;
-  showStatus(`${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${perFrame.toFixed(1)} ms per frame, ` +
-    `${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time.` + (notes.length ? ` Note: ${notes.join('; ')}.` : ''));
+  ui.takeInfo.textContent = takeDetails(t, notes);
+  ui.exportInfo.textContent = '';
+  takeNote = notes.length ? `${t.name}: ${notes[0]}.` : '';
   for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = false;
   ui.headRerollButton.disabled = !engine?.hasHeadMotion;
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
   player.show(0);
   return t;
-}
-
-async function loadSamples(): Promise<void> {
-  try {
-    sampleIndex = await fetchSampleIndex();
-    for (const c of sampleIndex.clips) {
-      const o = document.createElement('option');
-      o.value = c.name;
-      o.textContent = `"${c.text}" (${c.source === 'human' ? 'recorded voice' : c.voice}, ${c.seconds.toFixed(1)} s)`;
-      ui.sampleSelect.append(o);
-    }
-  } catch (e) {
-    ui.sampleSelect.disabled = true;
-    ui.sampleSelect.title = `No sample clips: ${(e as Error).message}`;
-  }
 }
 
 /** The same take with the head's own motion drawn again (the lips and eyes do not change). */
@@ -199,58 +204,83 @@ function rerollHead(): Promise<void> {
 function play(): void {
   if (!take) return;
   ui.playButton.textContent = 'Pause';
+  tell(takeNote || `Playing ${take.name}: Space or Escape pauses.`);
   void player.play();
 }
 
-function stopPlayback(): void {
-  player?.stop();
+/** After playback stops: the status says so (keeping the take's note) and what to do next. */
+function showPaused(what: string): void {
   ui.playButton.textContent = 'Play';
+  if (take) tell(takeNote || `${what}: press Play to watch it again, or open another file.`);
 }
 
+function stopPlayback(): void {
+  if (!player?.isPlaying) return;
+  player.stop();
+  showPaused('Paused');
+}
+
+/** Record starts and stops the microphone take. The button stays enabled (and keeps the focus) while it changes state. */
 async function toggleRecording(): Promise<void> {
   const e = needEngine();
-  if (!e) return;
-  if (recording) {
-    const r = recording;
-    recording = null;
-    ui.recordButton.textContent = 'Record';
-    ui.recordButton.setAttribute('aria-pressed', 'false');
-    ui.recordButton.disabled = true;
-    showStatus('Finishing the take…');
-    try {
-      const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));
-      if (!done) return showStatus('The take was too short to animate. Press Record and speak for a moment.', true);
-      const notes = audioNotes(done.samples, done.seconds).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
-      ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s`;
-      setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
-      document.body.dataset.take = 'ready';
-    } catch (err) {
-      showStatus(`The recording could not be finished: ${(err as Error).message}`, true);
-    } finally {
-      ui.recordButton.disabled = false;
-    }
-    return;
-  }
-  stopPlayback();
-  ui.recordButton.disabled = true;
+  if (!e || recordPending) return;
+  recordPending = true;
+  ui.recordButton.setAttribute('aria-disabled', 'true');
   try {
-    const r = await Recording.start(e, (f) => player.showLive(f), (err) => showStatus(`Live animation stopped: ${err.message}`, true));
+    await (recording ? stopRecording(e, recording) : startRecording(e));
+  } finally {
+    recordPending = false;
+    ui.recordButton.removeAttribute('aria-disabled');
+  }
+}
+
+async function startRecording(e: TalkingFaceEngine): Promise<void> {
+  stopPlayback();
+  try {
+    const r = await Recording.start(e, (f) => player.showLive(f), (err) => tell(`Live animation stopped: ${err.message}`, true));
     recording = r;
     ui.recordButton.textContent = 'Stop recording';
     ui.recordButton.setAttribute('aria-pressed', 'true');
     document.body.dataset.recording = 'true';
+    tell('Recording: the face follows your voice. Press Stop recording or Escape to stop.');
     const update = () => {
       if (recording !== r) return;
-      showStatus(r.describe());
+      ui.takeInfo.textContent = r.describe();
       setTimeout(update, 250);
     };
     update();
   } catch (err) {
-    showStatus(`${(err as Error).message}`, true);
+    tell(`${(err as Error).message}`, true);
     document.body.dataset.recording = 'error';
-  } finally {
-    ui.recordButton.disabled = false;
   }
+}
+
+async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> {
+  recording = null;
+  ui.recordButton.textContent = 'Record';
+  ui.recordButton.setAttribute('aria-pressed', 'false');
+  tell('Recording stopped; finishing the take…');
+  try {
+    const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));
+    if (!done) return tell('The take was too short to animate. Press Record and speak for a moment.', true);
+    const speech = await e.restUnlessSpeech(done.animation);
+    const notes = audioNotes(done.samples, done.seconds, speech).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
+    ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
+    setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
+    tell(takeNote || 'Recording is ready: press Play.');
+    document.body.dataset.take = 'ready';
+  } catch (err) {
+    tell(`The recording could not be finished: ${(err as Error).message}`, true);
+  }
+}
+
+/** Escape: stop recording, else playback, else the clip being animated. */
+function escape(): boolean {
+  if (recording) void toggleRecording();
+  else if (player?.isPlaying) stopPlayback();
+  else if (busy) busy.abort();
+  else return false;
+  return true;
 }
 
 bindControls({
@@ -263,11 +293,7 @@ bindControls({
     stopPlayback();
     player.show(frame);
   },
-  step: (delta) => {
-    stopPlayback();
-    player.show(player.current + delta);
-  },
-  hasTake: () => take !== null,
+  unlockAudio: () => player?.unlock(),
   setLoop: (on) => (player.loop = on),
   setArrows: (on) => takeView.setArrows(on),
   repaint: () => takeView.paint(take, engine, player.current, player.isPlaying),
@@ -281,8 +307,11 @@ bindControls({
     if (!engine) return;
     const want: Backend = choice === 'auto' ? autoBackend : (choice as Backend);
     engine.setBackend(want).then(
-      () => showStatus(`Decoder: ${engine!.backend}. New animations use it.`),
-      (err: Error) => showStatus(`Cannot use ${want}: ${err.message}`, true),
+      () => {
+        tell(`New animations will use the ${engine!.backend} decoder.`);
+        ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine!));
+      },
+      (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),
     );
   },
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
@@ -290,8 +319,21 @@ bindControls({
   rerollHead: () => void rerollHead(),
 });
 
+bindKeys({
+  escape,
+  hasTake: () => take !== null,
+  togglePlay: () => (player?.isPlaying ? stopPlayback() : play()),
+  step: (delta) => {
+    stopPlayback();
+    player.show(player.current + delta);
+  },
+  orbit: (azimuth, polar) => view?.orbit(azimuth, polar),
+  zoom: (factor) => view?.zoom(factor),
+});
+for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
+
 start().catch((e: Error) => {
-  showStatus(`Could not start: ${e.message}`, true);
+  tell(`Could not start: ${e.message}`, true);
   document.body.dataset.ready = 'error';
   console.error(e);
 });

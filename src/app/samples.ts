@@ -34,6 +34,24 @@ export async function fetchSampleIndex(): Promise<SampleIndex> {
   return res.json();
 }
 
+/** Fill the demo's sample menu from the index; without one the menu is disabled, its title saying why. */
+export async function fillSampleSelect(select: HTMLSelectElement): Promise<SampleIndex | null> {
+  try {
+    const index = await fetchSampleIndex();
+    for (const c of index.clips) {
+      const o = document.createElement('option');
+      o.value = c.name;
+      o.textContent = `"${c.text}" (${c.source === 'human' ? 'recorded voice' : c.voice}, ${c.seconds.toFixed(1)} s)`;
+      select.append(o);
+    }
+    return index;
+  } catch (e) {
+    select.disabled = true;
+    select.title = `No sample clips: ${(e as Error).message}`;
+    return null;
+  }
+}
+
 /** A sample's audio bytes and decoded ground truth, both checked against the index. */
 export async function fetchSample(c: SampleEntry, vertices: number, unitsPerMm: number): Promise<{ audio: ArrayBuffer; truth: Truth }> {
   const [audio, truthBytes] = await Promise.all([c.audio, c.ground_truth].map(async (f) => {

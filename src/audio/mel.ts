@@ -14,6 +14,11 @@ interface MeydaState {
   melFilterBank: unknown;
 }
 
+/** Each Mel band's width in FFT bins (its filter's weights summed; 0 for an empty filter), e.g. to compare bands' energy per bin. */
+export function melBandWidths(a: AudioConstants): Float64Array {
+  return MelBank.for(a).bandWidths;
+}
+
 /** Number of feature frames for `samples` samples. */
 export function melFrameCount(samples: number, a: AudioConstants): number {
   return Math.floor(samples / a.hop) + 1;
@@ -96,6 +101,8 @@ export class MelBank {
   private readonly acc = new Float32Array(1);
   private readonly filterStart: Int32Array;
   private readonly filterWeights: Float64Array[];
+  /** Each band's width: the sum of its filter's weights over the FFT bins (0 for an empty filter). */
+  readonly bandWidths: Float64Array;
 
   static for(a: AudioConstants): MelBank {
     const key = `${a.frame_size}/${a.sample_rate}/${a.n_mels}`;
@@ -132,6 +139,7 @@ export class MelBank {
     const bank = (Meyda as unknown as MeydaState).melFilterBank as ArrayLike<number>[];
     this.filterStart = new Int32Array(a.n_mels);
     this.filterWeights = [];
+    this.bandWidths = new Float64Array(a.n_mels);
     for (let i = 0; i < a.n_mels; i++) {
       const row = bank[i];
       let lo = 0, hi = n / 2;
@@ -139,6 +147,7 @@ export class MelBank {
       while (hi > lo && row[hi - 1] === 0) hi--;
       this.filterStart[i] = lo;
       this.filterWeights.push(Float64Array.from({ length: hi - lo }, (_, j) => row[lo + j]));
+      this.bandWidths[i] = this.filterWeights[i].reduce((sum, v) => sum + v, 0);
     }
   }
 

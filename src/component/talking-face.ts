@@ -18,7 +18,7 @@ import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { sharedEngine } from './engines';
-import { Player, audioNotes, type PlayerView } from '../player/player';
+import { Player, audioNotes, SHORT_CLIP_SECONDS, type PlayerView } from '../player/player';
 import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -156,26 +156,27 @@ export class TalkingFaceElement extends HTMLElement {
     }
     if (gen !== this.generation) return;
     const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
-    const notes = audioNotes(decoded.samples, seconds);
     const t0 = performance.now();
-    let animation: Animation;
+    let animation: Animation, computeMs: number, speech: boolean;
     try {
       animation = await engine.animate(decoded.samples, {
         unposed: true,
         blendshapes: this.blendshapes,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
+      computeMs = performance.now() - t0;
+      speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
     } catch (e) {
       throw this.fail('inference', `animation failed: ${(e as Error).message}`);
     }
     if (gen !== this.generation) return;
-    this.computeMs = performance.now() - t0;
-    this.audioSeconds = seconds;
+    const notes = audioNotes(decoded.samples, seconds, speech);
+    [this.computeMs, this.audioSeconds] = [computeMs, seconds];
     this.animation = animation;
     this.player?.load(animation, decoded.buffer);
     this.player?.show(0);
-    this.setStatus(`${animation.frames} frames, ${(this.audioSeconds / (this.computeMs / 1000)).toFixed(1)}x real time on ${engine.backend}` +
-      (notes.length ? ` (${notes.join('; ')})` : ''));
+    const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
+    this.setStatus(notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`);
     await this.player?.play(0);
   }
 
@@ -288,7 +289,8 @@ export class TalkingFaceElement extends HTMLElement {
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
       detail: {
         frame, time: frame / a.fps, mode: 'playback', backend: this.engine.backend,
-        inferenceMs: this.computeMs / a.frames, realTimeFactor: this.audioSeconds / (this.computeMs / 1000),
+        inferenceMs: this.computeMs / a.frames,
+        realTimeFactor: this.audioSeconds < SHORT_CLIP_SECONDS ? undefined : this.audioSeconds / (this.computeMs / 1000),
         ...(a.blendshapes && frameWeights(a.blendshapes, frame)),
       },
     }));

@@ -6,6 +6,8 @@
 import type { Manifest, ModelConstants } from '../model/manifest';
 import { contentWindows, softmaxRows } from './windows';
 import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
+import { melFlatness, speechProbabilities } from './voice-activity';
+import { melBandWidths } from '../audio/mel';
 
 /** Content frames [lo, hi) and the Mel frames [melLo, melHi) that compute them exactly. */
 export interface ContentRange {
@@ -25,6 +27,8 @@ export class ContentEncoder {
   private readonly m: ModelConstants;
   /** Indices of TONGUE_RAISING_PHONES among manifest.content_phones (names the manifest lacks are skipped). */
   private readonly tongueClasses: number[];
+  /** The silence class (voice-activity.ts), or -1 for a model without one (every frame then counts as speech). */
+  private readonly silence: number;
 
   private constructor(
     private readonly manifest: Manifest,
@@ -33,12 +37,13 @@ export class ContentEncoder {
   ) {
     this.m = manifest.model.config;
     this.tongueClasses = TONGUE_RAISING_PHONES.map((p) => manifest.content_phones.indexOf(p)).filter((k) => k >= 0);
+    this.silence = manifest.content_phones.indexOf('SIL');
   }
 
-  static async create(manifest: Manifest, files: Record<string, ArrayBuffer>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
+  static async create(manifest: Manifest, files: Record<string, ArrayBuffer | Promise<ArrayBuffer>>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
     const [content, hierarchical] = await Promise.all([
-      OnnxModel.create(specOf(manifest, 'content_encoder', files.content_encoder), providers),
-      OnnxModel.create(specOf(manifest, 'hierarchical', files.hierarchical), providers),
+      Promise.resolve(files.content_encoder).then((bytes) => OnnxModel.create(specOf(manifest, 'content_encoder', bytes), providers)),
+      Promise.resolve(files.hierarchical).then((bytes) => OnnxModel.create(specOf(manifest, 'hierarchical', bytes), providers)),
     ]);
     return new ContentEncoder(manifest, content, hierarchical);
   }
@@ -118,6 +123,18 @@ export class ContentEncoder {
       for (const j of this.tongueClasses) s += post[row + j];
       return Math.min(1, s);
     });
+  }
+
+  /**
+   * Each frame's speech probability (voice-activity.ts): 1 - P(SIL) at its content position, 0 where its `level`
+   * (RMS) is too low or its Mel frame (`mel`: frames r.melLo..r.melHi) is as flat as noise.
+   */
+  speechProbability(post: Float32Array, mel: Float32Array, melIndex: number[], r: ContentRange, level: number[]): Float32Array {
+    if (this.silence < 0) return new Float32Array(melIndex.length).fill(1);
+    const bands = this.manifest.audio.n_mels;
+    const widths = melBandWidths(this.manifest.audio);
+    const flatness = melIndex.map((k) => melFlatness(mel.subarray((k - r.melLo) * bands, (k - r.melLo + 1) * bands), widths));
+    return speechProbabilities(post, this.m.content_classes, this.silence, melIndex.map((k) => Math.floor(k / this.m.content_stride) - r.lo), level, flatness);
   }
 
   /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */

@@ -16,25 +16,39 @@ export type ExecutionProvider = 'webgpu' | 'wasm';
 /** Tried in this order; the first that creates every session wins. */
 export const PROVIDER_PRIORITY: ExecutionProvider[] = ['webgpu', 'wasm'];
 
-let ortModule: Promise<typeof Ort> | null = null;
+/**
+ * onnxruntime-web comes in two builds: the plain WebAssembly one (14 MB of wasm, about 2.6 MB compressed) and
+ * JSEP, which adds the WebGPU provider (28 MB). A page downloads only the one its providers need: JSEP when the
+ * WebGPU provider is asked for, the plain build otherwise (the encoders run on the wasm provider unless there is a
+ * hardware GPU: engine.ts).
+ */
+export type OrtBuild = 'wasm' | 'jsep';
 
-export function loadOrt(): Promise<typeof Ort> {
-  ortModule ??= import('onnxruntime-web').then((ort) => {
+export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
+  return providers.includes('webgpu') ? 'jsep' : 'wasm';
+}
+
+const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
+
+export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
+  ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then((ort) => {
     const isolated = Boolean((globalThis as { crossOriginIsolated?: boolean }).crossOriginIsolated);
     const cores = (globalThis.navigator as Navigator | undefined)?.hardwareConcurrency ?? 1;
     ort.env.wasm.numThreads = isolated ? Math.max(1, Math.min(4, cores)) : 1;
     // onnxruntime reports node placement notes as warnings through console.error; keep real errors only.
     ort.env.logLevel = 'error';
-    // The runtime files are served next to the app (vite.config.ts copies them to ort/): in a build,
+    // The runtime files are served next to the app (vite.config.ts copies them to ort/<version>/): in a build,
     // ort/ is the sibling of the folder holding this code (assets/ for the app, lib/ for the library),
-    // so an embedding page finds them wherever it hosts the build; in dev, at the server root.
-    const sibling = '../ort/'; // (a variable, so Vite does not try to bundle it as an asset)
+    // so an embedding page finds them wherever it hosts the build; in dev, at the server root. The version in
+    // the path lets a browser keep them for good (docs/embedding.md).
+    const folder = `ort/${ort.env.versions.web}/`;
+    const sibling = `../${folder}`; // (a variable: Vite would turn a template literal in new URL() into a glob of assets)
     ort.env.wasm.wasmPaths = import.meta.env.DEV
-      ? new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href
+      ? new URL(`${import.meta.env.BASE_URL}${folder}`, globalThis.location?.href ?? 'file:///').href
       : new URL(sibling, import.meta.url).href;
     return ort;
   });
-  return ortModule;
+  return ortModules[build];
 }
 
 export interface SessionSpec {
@@ -68,7 +82,7 @@ export class OnnxModel {
   ) {}
 
   static async create(spec: SessionSpec, providers: ExecutionProvider[] = PROVIDER_PRIORITY): Promise<OnnxModel> {
-    const ort = await loadOrt();
+    const ort = await loadOrt(ortBuildFor(providers));
     const errors: string[] = [];
     for (const provider of providers) {
       try {

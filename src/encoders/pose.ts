@@ -24,10 +24,10 @@ export class PoseEncoder {
     private readonly lstm: OnnxModel,
   ) {}
 
-  static async create(manifest: Manifest, files: Record<string, ArrayBuffer>, providers: ExecutionProvider[]): Promise<PoseEncoder> {
+  static async create(manifest: Manifest, files: Record<string, ArrayBuffer | Promise<ArrayBuffer>>, providers: ExecutionProvider[]): Promise<PoseEncoder> {
     const [conv, lstm] = await Promise.all([
-      OnnxModel.create(specOf(manifest, 'pose_conv', files.pose_conv), providers),
-      OnnxModel.create(specOf(manifest, 'pose_lstm', files.pose_lstm), providers),
+      Promise.resolve(files.pose_conv).then((bytes) => OnnxModel.create(specOf(manifest, 'pose_conv', bytes), providers)),
+      Promise.resolve(files.pose_lstm).then((bytes) => OnnxModel.create(specOf(manifest, 'pose_lstm', bytes), providers)),
     ]);
     return new PoseEncoder(manifest, conv, lstm);
   }

@@ -8,10 +8,10 @@
  *
  * Library code: no DOM.
  */
-import { loadArtefacts, type ArtefactOptions } from '../model/artefacts';
+import { fetchArtefacts, type ArtefactOptions } from '../model/artefacts';
 import type { Manifest } from '../model/manifest';
 import { parseSafetensors } from '../model/safetensors';
-import type { ExecutionProvider } from '../encoders/onnx-model';
+import { loadOrt, ortBuildFor, type ExecutionProvider } from '../encoders/onnx-model';
 import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
@@ -24,6 +24,8 @@ import { DEFAULT_CHUNK_FRAMES, Pipeline } from './pipeline';
 import { StreamSession } from './stream';
 import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
+import { speechFound } from '../encoders/voice-activity';
+import { poseFrames } from '../pose/posing';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -76,20 +78,28 @@ export class TalkingFaceEngine {
   private constructor(private readonly pipeline: Pipeline) {}
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
-    const { manifest, template, files } = await loadArtefacts(options);
+    // Each ONNX session is created as soon as its file has arrived (the first one starts onnxruntime's download and
+    // compile), while the others are still on their way: the model is ready sooner than if every file were awaited first.
+    // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
+    const [support, { manifest, template, files }] = await Promise.all([detectWebGPU(), fetchArtefacts(options)]);
     const m = manifest.model.config;
-    const support = await detectWebGPU();
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
-    const tensors = parseSafetensors(files.decoder_weights).tensors;
-    const weights = decoderWeights(tensors, m, manifest.model.layer_norm_eps);
-    const head = headMotionParams(tensors, m);
-    const [content, pose, decoders] = await Promise.all([
+    // The decoder's weights and the head's own motion come from the same file.
+    const weights = files.decoder_weights.then((bytes) => {
+      const tensors = parseSafetensors(bytes).tensors;
+      return { decoder: decoderWeights(tensors, m, manifest.model.layer_norm_eps), head: headMotionParams(tensors, m) };
+    });
+    const decoders = Promise.all([template, weights]).then(([t, w]) => DecoderBackends.create(w.decoder, t.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options));
+    const [content, pose, decoder, face, { head }] = await Promise.all([
       ContentEncoder.create(manifest, files, providers),
       PoseEncoder.create(manifest, files, providers),
-      DecoderBackends.create(weights, template.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options),
+      decoders,
+      template,
+      weights,
+      loadOrt(ortBuildFor(providers)), // onnxruntime's script now, while the files arrive
     ]);
-    const pipeline = new Pipeline(manifest, template, content, pose, decoders, head && new HeadMotion(head, m.d_model));
+    const pipeline = new Pipeline(manifest, face, content, pose, decoder, head && new HeadMotion(head, m.d_model));
     if (options.headMotionSeed !== undefined) pipeline.headSeed = options.headMotionSeed;
     return new TalkingFaceEngine(pipeline);
   }
@@ -178,6 +188,7 @@ export class TalkingFaceEngine {
     const phones = new Uint8Array(F);
     const blendshapes = options.blendshapes ? emptyBlendshapes(F) : undefined;
     const tongue = new Float32Array(F);
+    const speech = new Float32Array(F);
     const state = this.pipeline.newState({ blendshapes: options.blendshapes });
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
@@ -190,10 +201,11 @@ export class TalkingFaceEngine {
       phones.set(out.phones, f0);
       if (blendshapes) setBlendshapes(blendshapes, out.blendshapes!, f0);
       tongue.set(out.tongue, f0);
+      speech.set(out.speech, f0);
       options.onFrames?.(f0, out.vertices, out.pose, out);
       options.onProgress?.(f1, F);
     }
-    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue, blendshapes };
+    return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue, speech, blendshapes };
   }
 
   /**
@@ -242,6 +254,34 @@ export class TalkingFaceEngine {
     this.rest ??= this.animate(new Float32Array(this.manifest.audio.sample_rate), { unposed: true })
       .then((a) => a.unposed!.slice((a.frames - 1) * n3, a.frames * n3));
     return this.rest;
+  }
+
+  /** Whether a clip holds speech (encoders/voice-activity.ts): speech-like frames, and more than one steady sound. */
+  hasSpeech(animation: Animation): boolean {
+    return speechFound(animation.speech, animation.phones, animation.fps);
+  }
+
+  /**
+   * Whether `animation` holds speech (hasSpeech); where it does not (noise, music, a tone, which the model would
+   * otherwise mouth as if it were speech), its face is held at rest first (holdRest). What the demo and
+   * <talking-face> do with every offline take.
+   */
+  async restUnlessSpeech(animation: Animation): Promise<boolean> {
+    const speech = this.hasSpeech(animation);
+    if (!speech) await this.holdRest(animation);
+    return speech;
+  }
+
+  /** The face at rest on every frame of `animation` (its head poses kept), in place. */
+  async holdRest(animation: Animation): Promise<void> {
+    const rest = await this.restFace();
+    const n3 = rest.length;
+    const mm = this.pipeline.mmPerUnit;
+    const offsets = new Float32Array(animation.frames * n3);
+    for (let f = 0; f < animation.frames; f++) for (let i = 0; i < n3; i++) offsets[f * n3 + i] = rest[i] * mm - this.pipeline.templateMm[i];
+    const posed = poseFrames(this.pipeline.templateMm, offsets, animation.pose, animation.frames, mm);
+    if (animation.vertices.length) animation.vertices.set(posed.vertices);
+    animation.unposed?.set(posed.unposed);
   }
 
   resetTimes(): void {

@@ -17,6 +17,8 @@ export interface Frames {
   tongue: Float32Array;
   /** ARKit weights, visemes and head rotation per frame, when the stream was created with `blendshapes: true`. */
   blendshapes?: BlendshapeFrames;
+  /** (count): the probability that each frame is speech (encoders/voice-activity.ts). */
+  speech: Float32Array;
 }
 
 export interface Animation {
@@ -34,6 +36,8 @@ export interface Animation {
   tongue: Float32Array;
   /** Per frame: 52 ARKit weights, 15 visemes, head yaw / pitch / roll (animate with `blendshapes: true`). */
   blendshapes?: BlendshapeFrames;
+  /** (frames): the probability that each frame is speech: 1 - P(silence) where the signal is loud enough (encoders/voice-activity.ts). */
+  speech: Float32Array;
 }
 
 /** Milliseconds spent in each stage since the last resetTimes(). */
@@ -58,6 +62,7 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
   const phones = new Uint8Array(count);
   const blendshapes = chunks.every((f) => f.blendshapes) && count > 0 ? emptyBlendshapes(count) : undefined;
   const tongue = new Float32Array(count);
+  const speech = new Float32Array(count);
   let i = 0;
   for (const f of chunks) {
     vertices.set(f.vertices, i * per);
@@ -66,9 +71,10 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
     phones.set(f.phones, i);
     if (blendshapes) setBlendshapes(blendshapes, f.blendshapes!, i);
     tongue.set(f.tongue, i);
+    speech.set(f.speech, i);
     i += f.count;
   }
-  return { fps, frames: count, vertices, pose, unposed, phones, tongue, blendshapes };
+  return { fps, frames: count, vertices, pose, unposed, phones, tongue, speech, blendshapes };
 }
 
 /** Room for `frames` frames of blendshape output. */

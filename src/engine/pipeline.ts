@@ -12,6 +12,7 @@ import type { PoseEncoder, PoseState } from '../encoders/pose';
 import type { DecoderBackends } from './backends';
 import { poseFrames } from '../pose/posing';
 import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
+import { levelAt } from '../encoders/voice-activity';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
 import type { Frames, StageTimes } from './frames';
 import { AvatarWeights } from '../avatar/weights';
@@ -108,6 +109,8 @@ export class Pipeline {
     const windows = this.content.windows(post, melIndex, range, K);
     const phones = this.content.heardPhones(post, melIndex, range);
     const tongue = this.content.tongueRaise(post, melIndex, range);
+    const level = melIndex.map((k) => levelAt(samples, offset, k * a.hop, a.frame_size));
+    const speech = this.content.speechProbability(post, mel, melIndex, range, level);
     this.times.content += performance.now() - t;
 
     t = performance.now();
@@ -139,7 +142,7 @@ export class Pipeline {
     }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;
-    const frames: Frames = { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones, tongue };
+    const frames: Frames = { count: melIndex.length, vertices, unposed, pose: decoded.pose, phones, tongue, speech };
     if (state.blendshapes) {
       t = performance.now();
       const posteriors = this.content.framePosteriors(post, melIndex, range);

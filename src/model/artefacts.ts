@@ -9,14 +9,6 @@ export class ModelLoadError extends Error {
   override name = 'ModelLoadError';
 }
 
-export interface ModelArtefacts {
-  manifest: Manifest;
-  manifestUrl: URL;
-  template: FaceTemplate;
-  /** The runtime files' bytes by manifest key (content_encoder, hierarchical, pose_conv, pose_lstm, decoder_weights). */
-  files: Record<string, ArrayBuffer>;
-}
-
 export interface ArtefactOptions {
   /** URL of models/manifest.json (default DEFAULT_MANIFEST_URL, against the page). */
   manifestUrl?: string | URL;
@@ -24,8 +16,8 @@ export interface ArtefactOptions {
   manifest?: Manifest;
   /** URL of the face template (default: the manifest's). */
   templateUrl?: string | URL;
-  /** The face template, when the caller has already loaded it (it must be the manifest's). */
-  template?: FaceTemplate;
+  /** The face template, when the caller has loaded it or is loading it (it must be the manifest's). */
+  template?: FaceTemplate | Promise<FaceTemplate>;
   fetch?: typeof fetch;
 }
 
@@ -59,8 +51,20 @@ export async function sha256Hex(bytes: ArrayBuffer): Promise<string> {
   return Array.from(new Uint8Array(await crypto.subtle.digest('SHA-256', bytes)), (b) => b.toString(16).padStart(2, '0')).join('');
 }
 
-/** Everything the engine needs, fetched in parallel and checked. */
-export async function loadArtefacts(options: ArtefactOptions = {}): Promise<ModelArtefacts> {
+/** The manifest, with the template and every runtime file on their way (each checked when it arrives). */
+export interface ArrivingArtefacts {
+  manifest: Manifest;
+  manifestUrl: URL;
+  template: Promise<FaceTemplate>;
+  /** The runtime files' bytes by manifest key, each as soon as it has arrived and matched its SHA-256. */
+  files: Record<string, Promise<ArrayBuffer>>;
+}
+
+/**
+ * The manifest, then every file fetched in parallel: the caller can start on a file (e.g. an ONNX session) while the
+ * others are still arriving. Every promise must be awaited, or handed to one that is.
+ */
+export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<ArrivingArtefacts> {
   const fetchFn = options.fetch ?? fetch.bind(globalThis);
   const { manifest, manifestUrl } = options.manifest
     ? { manifest: checkManifest(options.manifest), manifestUrl: resolveManifestUrl(options.manifestUrl) }
@@ -73,14 +77,15 @@ export async function loadArtefacts(options: ArtefactOptions = {}): Promise<Mode
     if ((await sha256Hex(bytes)) !== manifest.sha256[key]) throw new ModelLoadError(`model file ${manifest.files[key]} is corrupt or from another export (SHA-256 mismatch)`);
     return bytes;
   };
-  const templatePromise = options.template
+  const template = (options.template
     ? Promise.resolve(options.template)
     : loadTemplate(templateUrlOf(manifest, manifestUrl, options.templateUrl), fetchFn).catch((e: Error) => {
       throw new ModelLoadError(`the face template could not be loaded: ${e.message}`);
-    });
-  const [template, ...bytes] = await Promise.all([templatePromise, ...manifest.runtime_files.map(file)]);
-  if (template.id !== manifest.template.id) {
-    throw new ModelLoadError(`the model was trained on the face template "${manifest.template.id}" and cannot drive "${template.id}" (every template needs its own trained model)`);
-  }
-  return { manifest, manifestUrl, template, files: Object.fromEntries(manifest.runtime_files.map((k, i) => [k, bytes[i]])) };
+    })).then((t) => {
+    if (t.id !== manifest.template.id) {
+      throw new ModelLoadError(`the model was trained on the face template "${manifest.template.id}" and cannot drive "${t.id}" (every template needs its own trained model)`);
+    }
+    return t;
+  });
+  return { manifest, manifestUrl, template, files: Object.fromEntries(manifest.runtime_files.map((k) => [k, file(k)])) };
 }

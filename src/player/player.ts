@@ -25,13 +25,20 @@ export interface PlayerView {
 
 /** Longer clips get a note with the expected time (they still work: memory stays bounded). */
 export const LONG_CLIP_SECONDS = 120;
+/** Shorter clips get a note, and no speed figure (a few frames measure start-up, not speed). */
+export const SHORT_CLIP_SECONDS = 0.5;
 
-/** Notes for a person about a clip's audio: silent, clipped, long. Empty when there is nothing to say. */
-export function audioNotes(samples: Float32Array, seconds: number): string[] {
+/**
+ * Notes for a person about a clip's audio: silent, no speech in it (`speech`: the engine's hasSpeech, once
+ * animated), clipped, very short, long. Empty when there is nothing to say.
+ */
+export function audioNotes(samples: Float32Array, seconds: number, speech = true): string[] {
   const lv = levels(samples);
   const notes: string[] = [];
   if (lv.peak < 1e-3) notes.push('the audio is silent, so the mouth stays closed');
+  else if (!speech) notes.push('no speech was found in it (noise, music or a tone?), so the mouth stays at rest');
   if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of the samples are clipped (distorted); the motion may be less accurate`);
+  if (seconds < SHORT_CLIP_SECONDS) notes.push(`a very short clip (${seconds.toFixed(2)} s): too short to show much`);
   if (seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it is animated in chunks with bounded memory; Cancel stops it`);
   return notes;
 }
@@ -166,6 +173,13 @@ export class Player {
       };
       requestAnimationFrame(tick);
     });
+  }
+
+  /** Create and resume the audio output now, within a person's gesture, so a take animated later may play (autoplay rules). */
+  unlock(): void {
+    this.context ??= new AudioContext();
+    // Deliberate: resume() rejects only when the context is closed, and then play() throws with the reason.
+    void this.context.resume().catch(() => undefined); // rejects only on a closed context; play() then says why
   }
 
   /** Stop playback (the face keeps the frame it shows). */

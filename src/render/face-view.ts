@@ -27,6 +27,8 @@ export interface FaceViewOptions {
 
 /** Seconds for speech to blend in, and back out to the rest face. */
 const BLEND_IN = 0.12, BLEND_OUT = 0.4;
+const scratchOffset = new THREE.Vector3();
+const scratchSpherical = new THREE.Spherical();
 const scratchAxis = new THREE.Vector3();
 const scratchQ = new THREE.Quaternion();
 const eyeTarget = new THREE.Vector3();
@@ -150,6 +152,27 @@ export class FaceView {
 
   requestRender(): void {
     this.needsRender = true;
+  }
+
+  /** Turn the camera around the face (radians: left-right, up-down), as a drag would: the keyboard's orbit. */
+  orbit(azimuth: number, polar: number): void {
+    const offset = scratchOffset.copy(this.camera.position).sub(this.controls.target);
+    scratchSpherical.setFromVector3(offset);
+    scratchSpherical.theta += azimuth;
+    scratchSpherical.phi = Math.min(Math.PI - 0.05, Math.max(0.05, scratchSpherical.phi + polar));
+    this.camera.position.copy(this.controls.target).add(offset.setFromSpherical(scratchSpherical));
+    this.camera.lookAt(this.controls.target);
+    this.controls.update();
+    this.requestRender();
+  }
+
+  /** Move the camera towards the face (factor < 1) or away from it (> 1), as the scroll wheel would. */
+  zoom(factor: number): void {
+    const offset = scratchOffset.copy(this.camera.position).sub(this.controls.target);
+    const distance = Math.min(this.controls.maxDistance, Math.max(this.controls.minDistance, offset.length() * factor));
+    this.camera.position.copy(this.controls.target).add(offset.setLength(distance));
+    this.controls.update();
+    this.requestRender();
   }
 
   /**

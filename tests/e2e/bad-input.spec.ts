@@ -51,7 +51,7 @@ test.describe('the demo with a broken model', () => {
     await page.route('**/models/gava.safetensors', (route) => route.fulfill({ status: 200, contentType: 'application/octet-stream', body: Buffer.from('not the weights') }));
     await page.goto('/');
     await expect(page.locator('body')).toHaveAttribute('data-engine', 'error', { timeout: 60_000 });
-    await expect(page.locator('#status')).toContainText('corrupt');
+    await expect(page.locator('#details')).toContainText('corrupt');
     await expect(page.locator('#status')).toContainText('The face can still be viewed');
     await page.locator('#file-input').setInputFiles(SPEECH);
     await expect(page.locator('#status')).toContainText('The model is not loaded');
@@ -62,7 +62,7 @@ test.describe('the demo with a broken model', () => {
     await page.route('**/models/manifest.json', (route) => route.fulfill({ status: 404, body: 'not found' }));
     await page.goto('/');
     await expect(page.locator('body')).toHaveAttribute('data-engine', 'error', { timeout: 60_000 });
-    await expect(page.locator('#status')).toContainText('HTTP 404');
+    await expect(page.locator('#details')).toContainText('HTTP 404');
     await expect(page.locator('body')).toHaveAttribute('data-ready', 'true');
   });
 

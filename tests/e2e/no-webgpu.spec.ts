@@ -13,9 +13,9 @@ test.use({
 test('without WebGPU the CPU decoder animates, and the page says why', async ({ page }) => {
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
-  await expect(page.locator('#status')).toContainText('WebGPU: none');
+  await expect(page.locator('#details')).toContainText('WebGPU: none');
   await expect(page.locator('#backend-select option[value="webgpu"]')).toBeDisabled();
   await page.locator('#file-input').setInputFiles(SPEECH);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
-  await expect(page.locator('#status')).toContainText('Decoder cpu');
+  await expect(page.locator('#details')).toContainText('Decoder cpu');
 });

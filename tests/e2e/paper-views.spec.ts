@@ -24,7 +24,7 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
   await page.locator('#sample-select').selectOption(first!);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
-  await expect(page.locator('#status')).toContainText(/E_vl on this clip: \d+\.\d\d mm/);
+  await expect(page.locator('#details')).toContainText(/E_vl on this clip: \d+\.\d\d mm/);
   const take = await page.evaluate(() => ({ frames: (globalThis as unknown as { talkingFace: TF }).talkingFace.take!.animation.frames, truth: (globalThis as unknown as { talkingFace: TF }).talkingFace.take!.truth?.frames }));
   expect(Math.abs(take.frames - take.truth!)).toBeLessThanOrEqual(1);
 
@@ -108,5 +108,5 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
   // The page says what it did.
   await page.locator('#export-glb').click();
-  await expect(page.locator('#status')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/);
+  await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/);
 });

@@ -10,14 +10,19 @@ test.describe('animating an audio file', () => {
     await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
   });
 
-  test('speech opens and closes the mouth, and the take can be played', async ({ page }) => {
+  test('speech opens and closes the mouth, and the take plays as soon as it is animated', async ({ page }) => {
     await page.locator('#file-input').setInputFiles(SPEECH);
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
-    await expect(page.locator('#status')).toContainText('x real time');
+    await expect(page.locator('#details')).toContainText('x real time');
+    await expect(page.locator('#status')).not.toContainText('no speech');
     const gaps = await lipGaps(page);
     expect(gaps.length).toBe(framesOf(SPEECH));
     expect(Math.max(...gaps) - Math.min(...gaps)).toBeGreaterThan(2); // it moves by millimetres, not noise
     await expect(page.locator('#play-button')).toBeEnabled();
+    await expect(page.locator('#play-button')).toHaveText('Pause'); // playing without a press
+    await expect.poll(() => page.locator('#scrub').inputValue(), { timeout: 10_000 }).not.toBe('0');
+    await page.locator('#play-button').click();
+    await expect(page.locator('#play-button')).toHaveText('Play');
     await page.locator('#play-button').click();
     await expect(page.locator('#play-button')).toHaveText('Pause');
   });

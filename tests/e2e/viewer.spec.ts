@@ -8,7 +8,8 @@ test.describe('the face viewer', () => {
 
   test('renders the shaded face filling a sensible part of the frame', async ({ page }) => {
     const canvas = page.locator('#face-canvas');
-    const shot = await canvas.screenshot();
+    // (Without the "Prediction" caption, which sits over the canvas's corner: the box and centre are the face's own.)
+    const shot = await canvas.screenshot({ style: '.view figcaption { visibility: hidden; }' });
     const s = await imageStats(page, shot);
     // A shaded face, not a flat fill: many colours, and it covers 15-85% of the canvas, roughly centred.
     expect(s.distinctColours).toBeGreaterThan(50);
@@ -21,14 +22,14 @@ test.describe('the face viewer', () => {
     await test.info().attach('viewer.png', { body: shot, contentType: 'image/png' });
   });
 
-  test('finds the WebGPU adapter and says so in the status line', async ({ page }) => {
+  test('finds the WebGPU adapter and says so in the details', async ({ page }) => {
     const gpu = await page.evaluate(() => {
       const g = (globalThis as unknown as { talkingFace: { gpu: { available: boolean; info: { architecture: string } | null } } }).talkingFace.gpu;
       return { available: g.available, architecture: g.info?.architecture };
     });
     expect(gpu.available).toBe(true);
     expect(gpu.architecture).toBe('swiftshader');
-    await expect(page.locator('#status')).toContainText('WebGPU adapter: google swiftshader');
+    await expect(page.locator('#details')).toContainText('WebGPU adapter: google swiftshader');
   });
 
   test('draws a whole head: skull and neck around the face, eyes, teeth, tongue, the mouth inside', async ({ page }) => {

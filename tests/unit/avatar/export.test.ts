@@ -25,7 +25,7 @@ function take(): Animation {
     pose[f * 6 + 1] = 0.01 * f; // a turn about y: yaw
   }
   b.arkit[7 * 52 + ARKIT_NAMES.indexOf('eyeBlinkLeft')] = 1;
-  return { fps: 30, frames: F, vertices: new Float32Array(0), pose, phones: new Uint8Array(F), tongue: new Float32Array(F), blendshapes: b };
+  return { fps: 30, frames: F, vertices: new Float32Array(0), pose, phones: new Uint8Array(F), tongue: new Float32Array(F), speech: new Float32Array(F), blendshapes: b };
 }
 
 describe('exports', () => {

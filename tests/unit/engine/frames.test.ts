@@ -9,6 +9,7 @@ const chunk = (first: number, count: number, n: number): Frames => ({
   pose: Float32Array.from({ length: count * 6 }, (_, i) => first * 6 + i),
   phones: Uint8Array.from({ length: count }, (_, i) => first + i),
   tongue: Float32Array.from({ length: count }, (_, i) => (first + i) / 10),
+  speech: Float32Array.from({ length: count }, (_, i) => (first + i) / 100),
 });
 
 describe('joinFrames', () => {
@@ -21,6 +22,7 @@ describe('joinFrames', () => {
     expect(Array.from(a.pose)).toEqual(Array.from({ length: 9 * 6 }, (_, i) => i));
     expect(Array.from(a.phones)).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
     expect(Array.from(a.tongue)).toEqual(Array.from({ length: 9 }, (_, i) => Math.fround(i / 10)));
+    expect(Array.from(a.speech, (p) => Math.round(p * 100))).toEqual([0, 1, 2, 3, 4, 5, 6, 7, 8]);
   });
 
   it('joins the blend-shape output too, when every chunk carries it', () => {

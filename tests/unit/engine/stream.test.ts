@@ -26,7 +26,7 @@ function standIn(calls: [number, number, number][]): Pipeline {
       calls.push([f0, f1, Number.isFinite(total) ? total : -1]);
       expect(offset + samples.length).toBeGreaterThanOrEqual(Number.isFinite(total) ? total : (f1 - 1) * (RATE / FPS) + LOOK_AHEAD);
       const count = f1 - f0;
-      return { count, vertices: Float32Array.from({ length: count }, (_, i) => f0 + i), unposed: new Float32Array(count), pose: new Float32Array(count * 6), phones: new Uint8Array(count), tongue: new Float32Array(count) };
+      return { count, vertices: Float32Array.from({ length: count }, (_, i) => f0 + i), unposed: new Float32Array(count), pose: new Float32Array(count * 6), phones: new Uint8Array(count), tongue: new Float32Array(count), speech: new Float32Array(count) };
     },
   } as unknown as Pipeline;
 }

@@ -3,7 +3,7 @@
  * the pose goes, the shape mapping, play / stop / end / loop, and the notes it writes about a clip's audio.
  */
 import { afterEach, beforeEach, describe, expect, it } from 'vitest';
-import { Player, audioNotes, LONG_CLIP_SECONDS } from '../../../src/player/player';
+import { Player, audioNotes, LONG_CLIP_SECONDS, SHORT_CLIP_SECONDS } from '../../../src/player/player';
 import type { FaceView } from '../../../src/render/face-view';
 import { emptyBlendshapes, type Animation } from '../../../src/engine/frames';
 import type { BlendshapeFrames } from '../../../src/avatar/weights';
@@ -31,6 +31,7 @@ function animation(frames: number): Animation {
     pose: Float32Array.from({ length: frames * 6 }, (_, i) => (i % 6 < 3 ? Math.floor(i / 6) : 10 * Math.floor(i / 6))),
     phones: new Uint8Array(frames),
     tongue: new Float32Array(frames),
+    speech: new Float32Array(frames),
   };
 }
 
@@ -90,7 +91,7 @@ describe('Player', () => {
     p.load(a, {} as AudioBuffer);
     p.show(2);
     expect(got).toEqual([[2, 0.5]]);
-    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), tongue: new Float32Array(3), blendshapes: a.blendshapes });
+    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), tongue: new Float32Array(3), speech: new Float32Array(3), blendshapes: a.blendshapes });
     expect(got[1]).toEqual([2, 0.5]); // the chunk's last frame
     p.load(animation(4), {} as AudioBuffer); // a take without blend shapes: nothing to hand over
     p.show(1);
@@ -161,5 +162,13 @@ describe('audioNotes', () => {
     const clipped = Float32Array.from(speech, (v) => Math.max(-1, Math.min(1, v * 10)));
     expect(audioNotes(clipped, 1).join()).toMatch(/clipped/);
     expect(audioNotes(speech, LONG_CLIP_SECONDS + 1).join()).toMatch(/long clip/);
+  });
+
+  it('says when no speech was found (not for a silent clip, already said) and when a clip is very short', () => {
+    const sound = Float32Array.from({ length: 16000 }, (_, i) => 0.3 * Math.sin(i / 7));
+    expect(audioNotes(sound, 1, false)).toEqual(['no speech was found in it (noise, music or a tone?), so the mouth stays at rest']);
+    expect(audioNotes(new Float32Array(16000), 1, false).join()).not.toMatch(/no speech/);
+    expect(audioNotes(sound.subarray(0, 3200), 0.2).join()).toMatch(/very short clip \(0\.20 s\)/);
+    expect(audioNotes(sound, SHORT_CLIP_SECONDS)).toEqual([]);
   });
 });

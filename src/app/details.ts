@@ -1,0 +1,29 @@
+/**
+ * What the Details disclosure under the status line says (issue 18): the technical side of what the status line
+ * tells in plain words. The face and the GPU adapter, the model and its decoder, and each take's figures and notes.
+ */
+import type { FaceTemplate } from '../template/face-template';
+import type { WebGPUSupport } from '../gpu/capabilities';
+import type { TalkingFaceEngine } from '../engine/engine';
+import { simdUnavailable } from '../attention/simd-kernel';
+import { SHORT_CLIP_SECONDS } from '../player/player';
+import type { Take } from './take-view';
+
+export function setupDetails(face: FaceTemplate, gpu: WebGPUSupport): string {
+  return `Face: ${face.id} (${face.vertexCount} vertices). ` +
+    (gpu.available ? `WebGPU adapter: ${gpu.description}.` : `WebGPU: none (${gpu.description}); the CPU path will be used.`);
+}
+
+/** The decoder's line: which one, why, and the CPU decoder's arithmetic and threads. */
+export function decoderDetails(e: TalkingFaceEngine): string {
+  const kernel = e.cpuKernel === 'wasm-simd' ? 'WebAssembly SIMD' : `JavaScript (no SIMD: ${simdUnavailable || 'unavailable'})`;
+  return `Decoder: ${e.backend} (${e.backendReason}; CPU decoder: ${kernel} on ${e.cpuThreads} thread${e.cpuThreads > 1 ? 's' : ''}).`;
+}
+
+/** A take's figures (no speed figure for a very short clip: its few frames measure start-up, not speed) and notes. */
+export function takeDetails(t: Take, notes: string[]): string {
+  const speed = t.seconds < SHORT_CLIP_SECONDS
+    ? 'no speed figure for a clip this short'
+    : `${(t.computeMs / t.animation.frames).toFixed(1)} ms per frame, ${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time`;
+  return `${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
+}

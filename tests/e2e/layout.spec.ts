@@ -1,0 +1,74 @@
+import { test, expect } from './fixtures';
+import { fakeMicrophone } from '../../playwright.config';
+import { SPEECH, speechSamples, wav } from './helpers/audio';
+
+/**
+ * A steady layout (issue 18): whatever the page is doing and whatever its status line says, the face's canvas
+ * keeps its size and the controls keep their places. Measured at idle, while animating, playing, recording, and
+ * after an error; any shift of more than half a pixel fails.
+ */
+test.use({ launchOptions: fakeMicrophone(SPEECH) });
+
+const WATCHED = ['#face-canvas', '#timeline', '#file-input + span', '#record-button', '#sample-select', '#backend-select',
+  '#play-button', '#scrub', '#time-label', '#paint-select', '#export-glb', '#export-raw', '#status', '#details'];
+
+type Boxes = Record<string, { x: number; y: number; width: number; height: number }>;
+
+async function boxes(page: import('@playwright/test').Page): Promise<Boxes> {
+  return page.evaluate((ids) => Object.fromEntries(ids.map((id) => {
+    const r = document.querySelector(id)!.getBoundingClientRect();
+    return [id, { x: r.x, y: r.y, width: r.width, height: r.height }];
+  })), WATCHED);
+}
+
+function shifts(base: Boxes, now: Boxes): string[] {
+  const out: string[] = [];
+  for (const id of WATCHED) {
+    for (const k of ['x', 'y', 'width', 'height'] as const) {
+      if (Math.abs(base[id][k] - now[id][k]) > 0.5) out.push(`${id} ${k} ${base[id][k].toFixed(1)} -> ${now[id][k].toFixed(1)}`);
+    }
+  }
+  return out;
+}
+
+test('the canvas and the controls stay put at idle, animating, playing, recording and after an error', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#sample-select option')).toHaveCount(4);
+  const idle = await boxes(page);
+  const states: Record<string, Boxes> = {};
+
+  // Animating: a clip long enough to be caught in progress (the status then says which frame).
+  const { samples, rate } = speechSamples();
+  const long = new Float32Array(rate * 40);
+  for (let o = 0; o < long.length; o += samples.length) long.set(samples.subarray(0, Math.min(samples.length, long.length - o)), o);
+  await page.locator('#file-input').setInputFiles({ name: 'a-rather-long-file-name-for-a-forty-second-recording-of-speech.wav', mimeType: 'audio/wav', buffer: wav([long], rate) });
+  await expect(page.locator('#status')).toContainText(/frame \d+ of/, { timeout: 30_000 });
+  states.animating = await boxes(page);
+  await expect(page.locator('#cancel-button')).toBeHidden({ timeout: 120_000 });
+
+  // Playing: the take plays as soon as it is animated.
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+  states.playing = await boxes(page);
+  await page.locator('#play-button').click();
+  await expect(page.locator('#play-button')).toHaveText('Play');
+  states.paused = await boxes(page);
+
+  // Recording, with the live figures changing in the details.
+  await page.locator('#record-button').click();
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
+  await expect(page.locator('#record-button')).toHaveText('Stop recording');
+  states.recording = await boxes(page);
+  await page.locator('#record-button').click();
+  await expect(page.locator('#clip-info')).toContainText('Recording', { timeout: 60_000 });
+
+  // An error: a file that is not audio.
+  await page.locator('#file-input').setInputFiles({ name: 'broken.wav', mimeType: 'audio/wav', buffer: Buffer.from('RIFF....WAVEnot really audio') });
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'error', { timeout: 30_000 });
+  await expect(page.locator('#status')).toHaveClass(/error/);
+  states.error = await boxes(page);
+
+  for (const [state, b] of Object.entries(states)) expect(shifts(idle, b), `shifts while ${state}`).toEqual([]);
+  await test.info().attach('error-state.png', { body: await page.screenshot(), contentType: 'image/png' });
+});

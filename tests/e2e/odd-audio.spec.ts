@@ -1,0 +1,62 @@
+import { test, expect } from './fixtures';
+import { SAMPLE_RATE, SPEECH, speechSamples, wav, lipGaps } from './helpers/audio';
+
+/**
+ * Audio that is not speech, or too little of it (issue 18): noise and a tone get a note and a face at rest; a clip
+ * under half a second gets a note and no speed figure; a dropped file plays as soon as it is animated.
+ */
+test.describe('odd audio', () => {
+  test.beforeEach(async ({ page }) => {
+    await page.goto('/');
+    await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  });
+
+  // mulberry32: uniform in [-1, 1), every sample independent (white).
+  let seed = 7;
+  const random = () => {
+    seed = (seed + 0x6d2b79f5) | 0;
+    let t = Math.imul(seed ^ (seed >>> 15), 1 | seed);
+    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+    return (((t ^ (t >>> 14)) >>> 0) / 2 ** 32) * 2 - 1;
+  };
+  const cases: [string, () => Float32Array][] = [
+    ['five seconds of white noise', () => Float32Array.from({ length: 5 * SAMPLE_RATE }, () => 0.3 * random())],
+    ['three seconds of a 440 Hz tone', () => Float32Array.from({ length: 3 * SAMPLE_RATE }, (_, i) => 0.5 * Math.sin((2 * Math.PI * 440 * i) / SAMPLE_RATE))],
+  ];
+  for (const [name, make] of cases) {
+    test(`${name}: "no speech", and the mouth stays at rest`, async ({ page }) => {
+      await page.locator('#file-input').setInputFiles({ name: 'sound.wav', mimeType: 'audio/wav', buffer: wav([make()], SAMPLE_RATE) });
+      await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+      await expect(page.locator('#status')).toContainText('no speech was found');
+      await expect(page.locator('#details')).toContainText('no speech was found');
+      const gaps = await lipGaps(page);
+      console.log(`${name}: inner-lip gap at most ${Math.max(...gaps).toFixed(2)} mm over ${gaps.length} frames`);
+      expect(Math.max(...gaps), 'largest inner-lip gap (mm)').toBeLessThan(1);
+      expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth does not move (mm)').toBeLessThan(0.01);
+    });
+  }
+
+  test('a 0.2 s clip gets a note and no real-time factor', async ({ page }) => {
+    const { samples, rate } = speechSamples();
+    await page.locator('#file-input').setInputFiles({ name: 'tiny.wav', mimeType: 'audio/wav', buffer: wav([samples.subarray(rate, rate + rate / 5)], rate) });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#status')).toContainText('very short clip');
+    await expect(page.locator('#details')).toContainText('no speed figure');
+    await expect(page.locator('#details')).not.toContainText('real time');
+  });
+
+  test('a dropped file is animated and plays at once; speech still moves the mouth', async ({ page }) => {
+    const bytes = (await import('node:fs')).readFileSync(SPEECH).toString('base64');
+    await page.evaluate((b64) => {
+      const file = new File([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], 'dropped.wav', { type: 'audio/wav' });
+      const data = new DataTransfer();
+      data.items.add(file);
+      document.getElementById('stage')!.dispatchEvent(new DragEvent('drop', { dataTransfer: data, bubbles: true, cancelable: true }));
+    }, bytes);
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#play-button')).toHaveText('Pause');
+    await expect(page.locator('#status')).not.toContainText('no speech');
+    const gaps = await lipGaps(page);
+    expect(Math.max(...gaps) - Math.min(...gaps), 'speech moves the mouth (mm)').toBeGreaterThan(2);
+  });
+});

@@ -1,0 +1,46 @@
+/** fetchArtefacts (src/model/artefacts.ts): the manifest first, then every file on its own promise, each checked. */
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { describe, expect, it } from 'vitest';
+import { fetchArtefacts, ModelLoadError } from '../../../src/model/artefacts';
+
+const MODELS = resolve(import.meta.dirname, '../../../models');
+
+/** A fetch that serves models/ from disk, with `corrupt` paths answered by other bytes. */
+function diskFetch(corrupt: string[] = []): typeof fetch {
+  return (async (input: RequestInfo | URL) => {
+    const path = new URL(String(input)).pathname.replace(/^\/models\//, '');
+    const bytes = corrupt.includes(path) ? Buffer.from('not the file') : readFileSync(resolve(MODELS, path));
+    return new Response(bytes);
+  }) as typeof fetch;
+}
+
+const manifestUrl = 'http://test/models/manifest.json';
+
+describe('fetchArtefacts', () => {
+  it('hands each runtime file over on its own promise, checked against its SHA-256', async () => {
+    const a = await fetchArtefacts({ manifestUrl, fetch: diskFetch() });
+    expect(Object.keys(a.files).sort()).toEqual([...a.manifest.runtime_files].sort());
+    const pose = await a.files.pose_conv;
+    expect(pose.byteLength).toBe(readFileSync(resolve(MODELS, a.manifest.files.pose_conv)).length);
+    expect((await a.template).id).toBe(a.manifest.template.id);
+    await Promise.all(Object.values(a.files));
+  });
+
+  it('rejects only the corrupt file, with a message that names it', async () => {
+    const manifest = JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8'));
+    const a = await fetchArtefacts({ manifestUrl, fetch: diskFetch([manifest.files.hierarchical]) });
+    await expect(a.files.hierarchical).rejects.toThrow(ModelLoadError);
+    await expect(a.files.hierarchical).rejects.toThrow(/hierarchical.*SHA-256/);
+    await expect(a.files.content_encoder).resolves.toBeInstanceOf(ArrayBuffer);
+    await Promise.allSettled([a.template, ...Object.values(a.files)]);
+  });
+
+  it('refuses a template the model was not trained on', async () => {
+    const a = await fetchArtefacts({ manifestUrl, fetch: diskFetch() });
+    const other = { ...(await a.template), id: 'someone-else' };
+    const b = await fetchArtefacts({ manifestUrl, fetch: diskFetch(), template: Promise.resolve(other) });
+    await expect(b.template).rejects.toThrow(/trained on the face template/);
+    await Promise.allSettled([...Object.values(a.files), ...Object.values(b.files)]);
+  });
+});
