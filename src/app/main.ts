@@ -10,7 +10,7 @@ import { TalkingFaceEngine, type Backend } from '../engine/engine';
 import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
 import { decodeAudio } from '../audio/decode';
 import { Player, audioNotes } from '../player/player';
-import { TakeView, type Take } from './take-view';
+import { TakeView, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, takeDetails } from './details';
@@ -187,19 +187,8 @@ function setTake(t: Take, notes: string[] = []): Take {
 }
 
 /** The same take with the head's own motion drawn again (the lips and eyes do not change). */
-function rerollHead(): Promise<void> {
-  const t = take;
-  if (!t || !engine?.hasHeadMotion) return Promise.resolve();
-  return animateTake(t.name, async (e, signal) => {
-    e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
-    const t0 = performance.now();
-    const animation = await e.animate(t.samples, { unposed: true, signal });
-    setTake({ ...t, animation, computeMs: performance.now() - t0, lipError: undefined });
-    showStatus(`${ui.status.textContent} Head motion drawn with seed ${e.headMotionSeed}.`);
-    document.body.dataset.headSeed = String(e.headMotionSeed);
-    return take;
-  });
-}
+const rerollHead = (): Promise<void> => (take && engine?.hasHeadMotion
+  ? animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal))) : Promise.resolve());
 
 function play(): void {
   if (!take) return;

@@ -113,3 +113,12 @@ export class TakeView {
     if (on && !take?.truth) showLegend('Side by side needs a sample clip (it has ground truth).');
   }
 }
+
+/** The take with the head's own motion drawn with the next seed (the lips and eyes do not change). */
+export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal): Promise<Take> {
+  e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
+  document.body.dataset.headSeed = String(e.headMotionSeed);
+  const t0 = performance.now();
+  const animation = await e.animate(t.samples, { unposed: true, signal });
+  return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
+}

@@ -86,7 +86,7 @@ export class FaceView {
     const crown = this.model.shell ? this.model.shell.egg.center[1] + this.model.shell.egg.up : m.top;
     const target = new THREE.Vector3(m.centerX, (crown + m.chin) / 2 - 0.02 * H, m.sideZ + 0.3 * m.halfWidth);
     // What the camera frames: the head from crown to chin with a margin, and a little more than its width.
-    this.frameSize = { height: 1.12 * (crown - m.chin), width: 2.5 * m.halfWidth };
+    this.frameSize = { height: 1.06 * (crown - m.chin), width: 2.5 * m.halfWidth };
     const face = new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(template.positions, 3));
     face.computeBoundingSphere();
     this.faceRadius = face.boundingSphere!.radius;
