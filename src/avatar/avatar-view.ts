@@ -7,6 +7,7 @@
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
+import { fitToCanvas } from '../render/canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
@@ -126,11 +127,7 @@ export class AvatarView {
   };
 
   private resize(): void {
-    const w = Math.max(1, this.canvas.clientWidth);
-    const h = Math.max(1, this.canvas.clientHeight);
-    this.renderer.setSize(w, h, false);
-    this.camera.aspect = w / h;
-    this.camera.updateProjectionMatrix();
+    fitToCanvas(this.canvas, this.renderer, this.camera);
     this.requestRender();
   }
 }

@@ -11,6 +11,7 @@
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
+import { fitToCanvas } from './canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { FaceTemplate } from '../template/face-template';
 import { Head } from './head';
@@ -310,11 +311,7 @@ export class FaceView {
 
   /** Fit the head in the canvas (a new size resets the zoom, not the direction the camera looks from). */
   private resize(): void {
-    const w = Math.max(1, this.canvas.clientWidth);
-    const h = Math.max(1, this.canvas.clientHeight);
-    this.renderer.setSize(w, h, false);
-    this.camera.aspect = w / h;
-    this.camera.updateProjectionMatrix();
+    fitToCanvas(this.canvas, this.renderer, this.camera);
     const tan = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2));
     const distance = Math.max(this.frameSize.height / (2 * tan), this.frameSize.width / (2 * tan * this.camera.aspect));
     const t = this.controls.target;
