@@ -62,7 +62,7 @@ function modelsDir(): Plugin {
 
 /**
  * `vite build` builds the app (index.html) into dist/. `vite build --mode test` (npm run build:test, after it) adds
- * the test-only pages under dist/dev/ (parity, bench, live, long): the tests and `npm run bench` use them; the
+ * the test-only pages under dist/dev/ (parity, bench, live, long, environment): the tests and `npm run bench` use them; the
  * shipped app does not carry them.
  */
 export default defineConfig(({ mode }) => {
@@ -79,7 +79,7 @@ export default defineConfig(({ mode }) => {
       emptyOutDir: !testPages,
       rolldownOptions: {
         input: (testPages
-          ? { parity: page('dev/parity.html'), bench: page('dev/bench.html'), live: page('dev/live.html'), long: page('dev/long.html') }
+          ? { parity: page('dev/parity.html'), bench: page('dev/bench.html'), live: page('dev/live.html'), long: page('dev/long.html'), environment: page('dev/environment.html') }
           : { main: page('index.html') }) as Record<string, string>,
       },
     },

@@ -59,13 +59,13 @@ async function start(): Promise<void> {
   engineReady.catch(() => undefined); // read by the await below
   const [face, gpu] = await Promise.all([template, gpuReady]);
   lastGpu = gpu;
-  view = new FaceView(ui.canvas, face);
+  view = new FaceView(ui.canvas, face, { lifePaused: true }); // still until the model is ready (face-view.ts)
   player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });
   takeView = new TakeView(view);
   publish();
   ui.setupInfo.textContent = setupDetails(face, gpu);
   showStatus('Loading the model…');
-  document.body.dataset.ready = 'true';
+  void view.drawn.then(() => (document.body.dataset.ready ||= 'true'));
   try {
     engine = await engineReady;
     player.unitsPerMm = engine.unitsPerMm;
@@ -75,6 +75,7 @@ async function start(): Promise<void> {
     ui.setupInfo.textContent += ` Model ${engine.manifest.model.name}. ${decoderDetails(engine)}`;
     tell('Ready: open or drop an audio file, choose a sample, or press Record.');
     document.body.dataset.engine = 'ready';
+    view.setLifePaused(false);
     void fillSampleSelect(ui.sampleSelect).then((index) => (sampleIndex = index));
     engine.restFace().then(
       (rest) => {
@@ -87,6 +88,7 @@ async function start(): Promise<void> {
     ui.setupInfo.textContent += ` The model could not be loaded: ${(e as Error).message}.`;
     tell('The model could not be loaded. The face can still be viewed; reload the page to try again (Details says why).', true);
     document.body.dataset.engine = 'error';
+    view.setLifePaused(false);
   }
 }
 

@@ -24,6 +24,12 @@ export interface FaceViewOptions {
   life?: boolean;
   /** Seed of the idle motion's schedule (default 1). */
   seed?: number;
+  /**
+   * Hold the life still until setLifePaused(false) (default false). The demo starts so while the model loads:
+   * without a GPU (SwiftShader, software) every idle frame is drawn on the CPU the model's sessions are created
+   * on, and drawing them made the model ready 1.5 s later (npm run bench, first load).
+   */
+  lifePaused?: boolean;
 }
 
 /** Seconds for speech to blend in, and back out to the rest face. */
@@ -46,6 +52,7 @@ export class FaceView {
   /** The last idle state drawn (null without life). */
   idleState: IdleState | null = null;
   private readonly idle: IdleMotion | null;
+  private lifePaused: boolean;
   private readonly blink: Float32Array;
   private readonly shown: Float32Array;
   private readonly frame: Float32Array;
@@ -80,6 +87,7 @@ export class FaceView {
     this.frame = new Float32Array(template.positions);
     this.blink = blinkField(template);
     this.idle = options.life === false ? null : new IdleMotion(options.seed ?? 1);
+    this.lifePaused = options.lifePaused ?? false;
     this.bodyHeight = this.model.body.scale.y;
 
     const m = this.model.measures;
@@ -103,7 +111,20 @@ export class FaceView {
     this.resizeObserver.observe(canvas);
     this.resize();
     this.compose();
-    this.loop();
+    // The first frame is drawn at the next animation frame, not here: what the caller starts meanwhile (the model's
+    // sessions, whose runtime downloads and compiles off the main thread) is on its way before the first draw, which
+    // under a software GPU holds the main thread for half a second (its shaders are linked then).
+    this.frameHandle = requestAnimationFrame(this.loop);
+    this.drawn = new Promise((resolve) => (this.onDrawn = resolve));
+  }
+
+  /** Resolves when the first frame has been drawn. */
+  readonly drawn: Promise<void>;
+  private onDrawn: (() => void) | null = null;
+
+  /** Pause (true) or resume (false) the breathing, blinks and eye movements; a paused face is drawn only when it changes. */
+  setLifePaused(paused: boolean): void {
+    this.lifePaused = paused;
   }
 
   /** The face's vertices drawn now (template units, N x 3), read-only. */
@@ -303,10 +324,14 @@ export class FaceView {
     this.frameHandle = requestAnimationFrame(this.loop);
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
-    if (this.idle || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
+    if ((this.idle && !this.lifePaused) || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
     if (!this.needsRender) return;
     this.needsRender = false;
     this.renderer.render(this.scene, this.camera);
+    if (this.onDrawn) {
+      this.onDrawn();
+      this.onDrawn = null;
+    }
   };
 
   /** Fit the head in the canvas (a new size resets the zoom, not the direction the camera looks from). */

@@ -1,7 +1,7 @@
 /**
  * How the head looks: physical materials for skin, lips, eyes, teeth, tongue and the inside of the mouth, the
- * skin's colours, and soft studio light: an environment map generated in code (three.js's RoomEnvironment through
- * PMREM: no download) plus a warm key, a cool fill and a rim light.
+ * skin's colours, and soft studio light: an environment map generated in code (environment.ts: a studio prefiltered
+ * on the CPU, no download, no shader to compile) plus a warm key, a cool fill and a rim light.
  *
  * Cost: the environment map is sampled only by the small wet surfaces that show its reflections (eyes, teeth,
  * tongue); the skin, which covers most pixels, takes its soft light from a hemisphere light instead, is drawn from
@@ -11,7 +11,7 @@
  * standard physically based material, whose fewer uniforms cost less main-thread time per draw.
  */
 import * as THREE from 'three';
-import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
+import { studioEnvironment } from './environment';
 import { lipMask, type FaceTemplate } from '../template/face-template';
 
 export const BACKGROUND = 0x1d2230;
@@ -110,11 +110,7 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
  * disposes of it with the renderer it was made by).
  */
 export function lightScene(scene: THREE.Scene, renderer: THREE.WebGLRenderer): THREE.Texture {
-  const pmrem = new THREE.PMREMGenerator(renderer);
-  const room = new RoomEnvironment();
-  const environment = pmrem.fromScene(room, 0.04).texture;
-  room.dispose();
-  pmrem.dispose();
+  const environment = studioEnvironment();
   reflectEnvironment(scene, environment);
   scene.background = new THREE.Color(BACKGROUND);
   scene.add(new THREE.HemisphereLight(0xfff1e6, 0x4a3a3a, 0.9));
