@@ -18,6 +18,7 @@ import { Head } from './head';
 import { blinkField } from './eyelids';
 import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
+import { pickFaceVertex, poseArrows } from './overlays';
 
 export interface FaceViewOptions {
   /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
@@ -214,24 +215,7 @@ export class FaceView {
 
   /** The face vertex nearest the point under (clientX, clientY), or null if the face is not there. */
   pickVertex(clientX: number, clientY: number): number | null {
-    const r = this.canvas.getBoundingClientRect();
-    const ndc = new THREE.Vector2(((clientX - r.left) / r.width) * 2 - 1, -((clientY - r.top) / r.height) * 2 + 1);
-    const ray = new THREE.Raycaster();
-    ray.setFromCamera(ndc, this.camera);
-    const skin = this.model.skin;
-    skin.geometry.computeBoundingSphere();
-    skin.geometry.computeBoundingBox();
-    const hit = ray.intersectObject(skin, false)[0];
-    if (!hit?.face) return null;
-    const local = skin.worldToLocal(hit.point.clone());
-    const pos = skin.geometry.getAttribute('position') as THREE.BufferAttribute;
-    let best: number | null = null, bestD = Infinity;
-    for (const v of [hit.face.a, hit.face.b, hit.face.c]) {
-      if (v >= this.template.vertexCount) continue; // the shell or the mouth: not the model's face
-      const d = local.distanceToSquared(new THREE.Vector3().fromBufferAttribute(pos, v));
-      if (d < bestD) [best, bestD] = [v, d];
-    }
-    return best;
+    return pickFaceVertex(this.canvas, this.camera, this.model.skin, this.template.vertexCount, clientX, clientY);
   }
 
   /**
@@ -240,19 +224,10 @@ export class FaceView {
    */
   showPoseArrows(on: boolean): void {
     if (on && !this.arrows) {
-      const tip = this.template.regions.nose_tip?.[0];
-      if (tip === undefined) return;
-      const geometry = this.model.skin.geometry;
-      const origin = new THREE.Vector3().fromArray(this.template.positions, 3 * tip);
-      const normal = new THREE.Vector3().fromBufferAttribute(geometry.getAttribute('normal') as THREE.BufferAttribute, tip).normalize();
-      const length = this.faceRadius * 0.9;
-      const template = new THREE.ArrowHelper(normal, origin, length, 0xb0b6c4, length * 0.15, length * 0.07);
-      const current = new THREE.ArrowHelper(normal, origin, length, 0xff8a3d, length * 0.15, length * 0.07);
-      template.name = 'pose_arrow_template';
-      current.name = 'pose_arrow_current';
-      this.scene.add(template);
-      this.head.add(current);
-      this.arrows = { template, current };
+      this.arrows = poseArrows(this.template, this.model.skin, this.faceRadius * 0.9);
+      if (!this.arrows) return;
+      this.scene.add(this.arrows.template);
+      this.head.add(this.arrows.current);
     } else if (!on && this.arrows) {
       this.scene.remove(this.arrows.template);
       this.head.remove(this.arrows.current);
