@@ -43,3 +43,29 @@ def test_two_process_ddp_with_gloo(corpus, tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     ck = torch.load(out / "final.pt", weights_only=False)
     assert ck["world_size"] == 2 and ck["step"] == 2
+
+
+def test_a_face_checkpoint_serves_as_the_frozen_front_end(trained_run, corpus, tmp_path):
+    """--frontend takes a face checkpoint's content encoder (as the shipped model's fine-tunes do), frozen."""
+    fe = train.load_frontend(str(trained_run / "final.pt"))
+    ck = torch.load(trained_run / "final.pt", weights_only=False)
+    assert fe["model_config"] == ck["model_config"] and fe["step"] == ck["step"]
+    assert fe["content"] and all(torch.equal(v, ck["model"][f"content.{k}"]) for k, v in fe["content"].items())
+    out = tmp_path / "tuned"
+    assert train.main(["--corpus", str(corpus.root), "--out", str(out), "--steps", "2", "--batch-clips", "2", "--frames", "4",
+                       "--frontend", str(trained_run / "final.pt"), "--init", str(trained_run / "final.pt")]) == 0
+    tuned = torch.load(out / "final.pt", weights_only=False)["model"]
+    for k, v in ck["model"].items():
+        if k.startswith("content."):
+            assert torch.equal(tuned[k], v), k  # frozen: the front-end is exactly the one given
+
+
+def test_frontend_rejects_other_files(tmp_path):
+    bad = tmp_path / "other.pt"
+    torch.save({"weights": {}}, bad)
+    try:
+        train.load_frontend(str(bad))
+    except SystemExit as e:
+        assert "neither a front-end" in str(e)
+    else:
+        raise AssertionError("load_frontend accepted a file that is neither")

@@ -83,8 +83,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--paper-loss", action="store_true", help="the paper's Eq. 3 exactly (no unposed or lip reconstruction terms; see losses.py)")
     ap.add_argument("--silence", type=float, default=0.2,
                     help="chance that a crop is pure silence with the rest face as target (data.py); 0 = the paper's data")
-    ap.add_argument("--frontend", help="a speech front-end trained on its own (talkingface.frontend.train: OUT/frontend.pt): "
-                    "its content encoder replaces the model's and stays frozen")
+    ap.add_argument("--frontend", help="a speech front-end trained on its own (talkingface.frontend.train: OUT/frontend.pt), "
+                    "or a face checkpoint whose content encoder to take (models/checkpoint.pt): it replaces the model's and stays frozen")
     ap.add_argument("--tune-frontend", action="store_true", help="with --frontend: fine-tune it with the face instead of freezing it")
     ap.add_argument("--closure-weight", type=float, default=LossWeights.closure,
                     help="extra weight of the gap term on frames where the true lips are closed (losses.py)")
@@ -95,6 +95,18 @@ def parse_args(argv=None) -> argparse.Namespace:
     if (args.minutes is None) == (args.steps is None):
         ap.error("give exactly one of --minutes and --steps")
     return args
+
+
+def load_frontend(path: str) -> dict:
+    """A front-end file (frontend.train's frontend.pt), or the content encoder of a face checkpoint in the same form
+    (so a model can be fine-tuned on the shipped front-end after runs/, which holds the front-end's own run, is gone)."""
+    ck = torch.load(path, map_location="cpu", weights_only=False)
+    if "content" in ck:
+        return ck
+    if "model" not in ck:
+        raise SystemExit(f"--frontend: {path} is neither a front-end (frontend.pt) nor a face checkpoint")
+    content = {k[len("content."):]: v for k, v in ck["model"].items() if k.startswith("content.")}
+    return {"model_config": ck["model_config"], "content": content, "step": ck["step"]}
 
 
 def main(argv=None) -> int:
@@ -112,7 +124,7 @@ def main(argv=None) -> int:
 
     ds = open_dataset(args.corpus, args.template, args.masks)
     audio = AudioConfig(fps=int(ds.fps))
-    frontend = torch.load(args.frontend, map_location="cpu", weights_only=False) if args.frontend else None
+    frontend = load_frontend(args.frontend) if args.frontend else None
     content_cfg = {k: frontend["model_config"][k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")} \
         if frontend else {}
     cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant, **content_cfg)
