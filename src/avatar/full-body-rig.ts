@@ -46,8 +46,9 @@ function skeleton(): BoneSpec[] {
     { name: 'Spine', parent: 'Hips', at: [0, 0.1, 0], segment: [0.12, 0.14, 0.1] },
     { name: 'Spine1', parent: 'Spine', at: [0, 0.12, 0], segment: [0.13, 0.15, 0.1] },
     { name: 'Spine2', parent: 'Spine1', at: [0, 0.13, 0], segment: [0.16, 0.17, 0.11] },
-    { name: 'Neck', parent: 'Spine2', at: [0, 0.16, 0], segment: [0.09, 0.05, 0.05] },
-    { name: 'Head', parent: 'Neck', at: [0, 0.09, 0] },
+    { name: 'Neck', parent: 'Spine2', at: [0, 0.16, 0], segment: [0.09, 0.045, 0.045] },
+    // The face's pivot (the template's origin) lies in front of the neck's axis, between the ears.
+    { name: 'Head', parent: 'Neck', at: [0, 0.09, 0.035] },
   ];
   for (const [side, s] of [['Left', 1], ['Right', -1]] as const) {
     const limb = (name: string, parent: string, at: [number, number, number], turn?: [number, number, number], segment?: [number, number, number]) =>
