@@ -152,6 +152,6 @@ test("TalkingHead refuses a face-only avatar: the page says what it lacks", asyn
   test.setTimeout(60_000);
   guard.allowConsoleError(/Avatar object Armature not found/);
   await page.goto('/examples/talkinghead.html?avatar=/examples/avatars/arkit-face.glb');
-  await expect(page.locator('#log')).toHaveText('error: Avatar object Armature not found', { timeout: 30_000 });
+  await expect(page.locator('#log')).toHaveText("error: Avatar object Armature not found (TalkingHead needs a full-body avatar with Ready Player Me's bone names)", { timeout: 30_000 });
   await expect(page.locator('#speak')).toBeDisabled();
 });
