@@ -2,12 +2,14 @@ import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { precompress } from './scripts/hosting';
+import { vendorTalkingHead } from './scripts/talkinghead-vendor';
 
 /**
  * The library build: dist/lib/talking-face.js (ES module) defines <talking-face> and exports the API
  * (src/component/index.ts). It runs after the app build (npm run build), whose dist/models/ and
- * dist/ort/ it uses: deploy lib/, models/ and ort/ side by side (docs/embedding.md). The example page
- * examples/embed.html is copied to dist/examples/.
+ * dist/ort/ it uses: deploy lib/, models/ and ort/ side by side (docs/embedding.md). The example pages
+ * (examples/) are copied to dist/examples/, with TalkingHead and its three.js in dist/examples/vendor/ for
+ * examples/talkinghead.html (scripts/talkinghead-vendor.ts).
  */
 export default defineConfig({
   publicDir: false,
@@ -28,6 +30,7 @@ export default defineConfig({
       name: 'talking-face-examples',
       closeBundle() {
         cpSync(resolve(import.meta.dirname, 'examples'), resolve(import.meta.dirname, 'dist/examples'), { recursive: true });
+        vendorTalkingHead(resolve(import.meta.dirname, 'dist/examples/vendor'));
         for (const dir of ['dist/lib', 'dist/examples']) precompress(resolve(import.meta.dirname, dir));
       },
     },

@@ -1,18 +1,21 @@
 /**
- * npm run make-avatars: the two test avatars, made from the face template and the ARKit basis (src/avatar/), no
- * third-party asset: examples/avatars/arkit-face.glb (the 52 ARKit morph targets and a "Head" node) and
- * examples/avatars/visemes-face.glb (only the 15 Oculus viseme targets, each a mix of the ARKit shapes). A unit
- * test checks that the committed files are exactly what this writes.
+ * npm run make-avatars: the test avatars, made from the face template and the ARKit basis (src/avatar/), no
+ * third-party asset: examples/avatars/arkit-face.glb (the 52 ARKit morph targets and a "Head" node),
+ * examples/avatars/visemes-face.glb (only the 15 Oculus viseme targets, each a mix of the ARKit shapes) and
+ * examples/avatars/arkit-full-body.glb (the ARKit face on a full-body skeleton with Ready Player Me's bone names,
+ * which TalkingHead requires; src/avatar/full-body-rig.ts). A unit test checks that the committed files are
+ * exactly what this writes.
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { decodeTemplate } from '../src/template/face-template';
 import { buildAvatarGlb } from '../src/avatar/avatar-mesh';
+import { buildFullBodyAvatarGlb } from '../src/avatar/full-body-rig';
 import { installFileReader } from '../tests/unit/helpers/file-reader';
 
 const ROOT = resolve(import.meta.dirname, '..');
 
-export const AVATARS = { 'arkit-face.glb': 'arkit', 'visemes-face.glb': 'visemes' } as const;
+export const AVATARS = { 'arkit-face.glb': 'arkit', 'visemes-face.glb': 'visemes', 'arkit-full-body.glb': 'full-body' } as const;
 
 export async function makeAvatars(): Promise<Record<string, Uint8Array>> {
   installFileReader();
@@ -20,7 +23,9 @@ export async function makeAvatars(): Promise<Record<string, Uint8Array>> {
   const template = await decodeTemplate(JSON.parse(readFileSync(resolve(ROOT, 'models/template/template.json'), 'utf8')),
     bin.buffer.slice(bin.byteOffset, bin.byteOffset + bin.byteLength) as ArrayBuffer);
   const out: Record<string, Uint8Array> = {};
-  for (const [file, morphs] of Object.entries(AVATARS)) out[file] = new Uint8Array(await buildAvatarGlb(template, morphs));
+  for (const [file, kind] of Object.entries(AVATARS)) {
+    out[file] = new Uint8Array(await (kind === 'full-body' ? buildFullBodyAvatarGlb(template) : buildAvatarGlb(template, kind)));
+  }
   return out;
 }
 

@@ -27,5 +27,7 @@ export { BlendshapeSolver, type SolverOptions, type SolverState } from './avatar
 export { AvatarWeights, frameWeights, yawPitchRoll, type BlendshapeFrames, type FrameWeights } from './avatar/weights';
 export { VisemeMap, PHONE_TO_VISEME } from './avatar/visemes';
 export { GltfAvatar, AvatarLoadError, type AvatarSummary } from './avatar/gltf-avatar';
-export { blendshapesJson, liveLinkFaceCsv, liveLinkTimecode, talkingHeadAnim, blendshapesGlb } from './avatar/export';
+export { blendshapesJson, liveLinkFaceCsv, liveLinkTimecode, blendshapesGlb } from './avatar/export';
+export { TalkingHeadDriver, talkingHeadAnim, talkingHeadAngles, TALKINGHEAD_SHAPES, TALKINGHEAD_HEAD, type TalkingHeadLike, type TalkingHeadOptions } from './avatar/talkinghead';
 export { avatarScene, visemeAsArkit, buildAvatarGlb } from './avatar/avatar-mesh';
+export { fullBodyScene, buildFullBodyAvatarGlb } from './avatar/full-body-rig';

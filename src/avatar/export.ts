@@ -68,21 +68,6 @@ export function liveLinkFaceCsv(animation: Animation): string {
   return lines.join('\n') + '\n';
 }
 
-/**
- * TalkingHead's animation template for `speakAudio({ audio, anim })` (its README, Appendix F): frame durations in
- * ms and, per ARKit name, the weights. Shapes that stay 0 throughout are left out.
- */
-export function talkingHeadAnim(animation: Animation): { name: string; dt: number[]; vs: Record<string, number[]> } {
-  const b = blendshapesOf(animation);
-  const A = ARKIT_NAMES.length;
-  const vs: Record<string, number[]> = {};
-  ARKIT_NAMES.forEach((name, k) => {
-    const track = Array.from({ length: animation.frames }, (_, f) => round(b.arkit[f * A + k]));
-    if (track.some((x) => x > 0)) vs[name] = track;
-  });
-  return { name: 'blendshapes', dt: Array.from({ length: animation.frames }, () => 1000 / animation.fps), vs };
-}
-
 /** .glb: the template with ARKit-named morph targets, their weights animated per frame, the head bone turning. */
 export async function blendshapesGlb(animation: Animation, template: FaceTemplate, basis: ArkitBasis): Promise<ArrayBuffer> {
   const b = blendshapesOf(animation);

@@ -1,9 +1,10 @@
 /**
  * The three exports of the blend-shape output (src/avatar/export.ts): JSON, CSV in Live Link Face's layout, and a
- * .glb whose morph targets carry ARKit's names and whose animation plays the weights; and TalkingHead's `anim`.
+ * .glb whose morph targets carry ARKit's names and whose animation plays the weights. (TalkingHead's `anim`:
+ * talkinghead.test.ts.)
  */
 import { beforeAll, describe, expect, it } from 'vitest';
-import { blendshapesGlb, blendshapesJson, liveLinkFaceCsv, liveLinkTimecode, talkingHeadAnim } from '../../../src/avatar/export';
+import { blendshapesGlb, blendshapesJson, liveLinkFaceCsv, liveLinkTimecode } from '../../../src/avatar/export';
 import { arkitBasis, type ArkitBasis } from '../../../src/avatar/basis';
 import { GltfAvatar } from '../../../src/avatar/gltf-avatar';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS, VISEME_NAMES } from '../../../src/avatar/names';
@@ -70,14 +71,6 @@ describe('exports', () => {
     expect(j.visemes[16][1]).toBe(1);
     expect(j.head[20][0]).toBeCloseTo(0.2, 5);
     expect(() => blendshapesJson({ ...take(), blendshapes: undefined })).toThrow(/animate with \{ blendshapes: true \}/);
-  });
-
-  it("TalkingHead's anim: 1000 / fps ms per frame, the shapes that move", () => {
-    const a = talkingHeadAnim(take());
-    expect(a.dt).toHaveLength(40);
-    expect(a.dt[0]).toBeCloseTo(1000 / 30, 9);
-    expect(Object.keys(a.vs).sort()).toEqual(['eyeBlinkLeft', 'jawOpen', 'mouthRight']);
-    expect(a.vs.jawOpen[10]).toBeCloseTo(0.25, 5);
   });
 
   it('.glb: the template with the 52 ARKit targets under a Head bone, the weights and the head keyed per frame', async () => {
