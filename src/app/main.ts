@@ -75,7 +75,6 @@ async function start(): Promise<void> {
     ui.setupInfo.textContent += ` Model ${engine.manifest.model.name}. ${decoderDetails(engine)}`;
     tell('Ready: open or drop an audio file, choose a sample, or press Record.');
     document.body.dataset.engine = 'ready';
-    view.setLifePaused(false);
     void fillSampleSelect(ui.sampleSelect).then((index) => (sampleIndex = index));
     engine.restFace().then(
       (rest) => {
@@ -88,7 +87,8 @@ async function start(): Promise<void> {
     ui.setupInfo.textContent += ` The model could not be loaded: ${(e as Error).message}.`;
     tell('The model could not be loaded. The face can still be viewed; reload the page to try again (Details says why).', true);
     document.body.dataset.engine = 'error';
-    view.setLifePaused(false);
+  } finally {
+    view.setLifePaused(false); // loaded or not, nothing more competes with the face for the main thread
   }
 }
 

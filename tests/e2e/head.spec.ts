@@ -1,3 +1,4 @@
+import type { Page } from '@playwright/test';
 import { test, expect } from './fixtures';
 
 /**
@@ -45,13 +46,18 @@ test('at rest the face keeps its mouth closed, blinks and moves its eyes within 
   expect(seen.eyeTurn, 'the eyes moved (radians)').toBeGreaterThan((0.5 * Math.PI) / 180);
 });
 
-test('an open vowel shows the inside of the mouth, with no background pixel inside the lips', async ({ page }) => {
-  test.setTimeout(120_000);
+/** The demo with its face at rest, then the first sample clip animated (a take ready). */
+async function animateFirstSample(page: Page): Promise<void> {
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
   const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
   await page.locator('#sample-select').selectOption(first!);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+}
+
+test('an open vowel shows the inside of the mouth, with no background pixel inside the lips', async ({ page }) => {
+  test.setTimeout(120_000);
+  await animateFirstSample(page);
   // The widest-open frame of the take (the inner-lip gap at the mouth's middle).
   const open = await page.evaluate(() => {
     const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
@@ -113,11 +119,7 @@ test('an open vowel shows the inside of the mouth, with no background pixel insi
 
 test('after speech the face blends back to its rest, mouth closed', async ({ page }) => {
   test.setTimeout(120_000);
-  await page.goto('/');
-  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
-  const first = await page.locator('#sample-select option').nth(1).getAttribute('value');
-  await page.locator('#sample-select').selectOption(first!);
-  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await animateFirstSample(page);
   const weight = () => page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.view.speechWeight);
   await expect.poll(weight).toBe(1); // a take's frame is shown
   // A chosen sample plays as soon as it is animated (issue 18).
