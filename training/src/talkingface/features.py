@@ -78,3 +78,13 @@ def log_mel(audio: np.ndarray, cfg: AudioConfig = AudioConfig()) -> np.ndarray:
 def frame_to_mel_index(frames: np.ndarray, cfg: AudioConfig = AudioConfig()) -> np.ndarray:
     """Animation frame i shows t = i / fps; its Mel frame is round(t * feature_rate) (round half to even)."""
     return np.round(np.asarray(frames) / cfg.fps * cfg.feature_rate).astype(np.int64)
+
+
+def warp_mel(mel: np.ndarray, factor: float) -> np.ndarray:
+    """Stretch the Mel axis by `factor` (> 1: a shorter vocal tract, formants move up), edge values held."""
+    n = mel.shape[1]
+    src = np.clip(np.arange(n) / factor, 0, n - 1)
+    lo = np.floor(src).astype(int)
+    hi = np.minimum(lo + 1, n - 1)
+    w = src - lo
+    return mel[:, lo] * (1 - w) + mel[:, hi] * w

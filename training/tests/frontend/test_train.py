@@ -28,10 +28,10 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
         rows.append({"key": f"s{i}", "seconds": 4.0})
     (speech / "index.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
     out = tmp_path / "fe"
-    fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(out), "--minutes", "0.05",
+    fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(out), "--steps", "12",
                    "--eval-every", "5", "--threads", "1"])
     ev = json.loads((out / "frontend_eval.json").read_text())
-    assert ev["step"] >= 5 and ev["history"][-1]["loss"] < ev["history"][0]["loss"]
+    assert ev["step"] == 12 and ev["history"][-1]["loss"] < ev["history"][0]["loss"]
     fe = torch.load(out / "frontend.pt", weights_only=False)
     run = tmp_path / "run"
     train.main(["--corpus", str(corpus.root), "--out", str(run), "--steps", "3", "--batch-clips", "2", "--frames", "4",
@@ -39,3 +39,11 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     model, _ = train.load_checkpoint(run / "final.pt", corpus.template)
     for k, v in fe["content"].items():  # frozen: the face's training left every front-end weight as it was
         torch.testing.assert_close(model.content.state_dict()[k], v, rtol=0, atol=0)
+    # --init continues from it on two speech sets: its Mel normalisation (not trained) comes with it unchanged
+    again = tmp_path / "fe2"
+    fe_train.main(["--speech", str(speech), str(speech), "--corpus", str(corpus.root), "--out", str(again),
+                   "--steps", "2", "--eval-every", "1000", "--threads", "1", "--init", str(out / "frontend.pt")])
+    fe2 = torch.load(again / "frontend.pt", weights_only=False)
+    assert fe2["args"]["speech"] == [str(speech), str(speech)] and fe2["args"]["init"] == str(out / "frontend.pt")
+    for k in ("norm.mean", "norm.std"):
+        torch.testing.assert_close(fe2["content"][k], fe["content"][k], rtol=0, atol=0)

@@ -69,3 +69,41 @@ def test_frontend_rejects_other_files(tmp_path):
         assert "neither a front-end" in str(e)
     else:
         raise AssertionError("load_frontend accepted a file that is neither")
+
+
+def test_content_warp_stretches_each_crop_within_its_range():
+    """A single bright band at 20 moves to 20 * f or 20 / f with f in [LO, HI], differently per crop."""
+    import numpy as np
+    mel = torch.zeros(64, 10, 80)
+    mel[..., 20] = 1.0
+    out = train.content_warp(mel, np.random.default_rng(0), 1.12, 1.22)
+    assert out.shape == mel.shape and torch.equal(mel[..., 20], torch.ones(64, 10))  # the input is left alone
+    centres = (out[:, 0] * torch.arange(80)).sum(-1) / out[:, 0].sum(-1)
+    factors = centres / 20
+    up, down = factors[factors > 1], factors[factors < 1]
+    assert len(up) > 10 and len(down) > 10
+    assert ((up > 1.10) & (up < 1.24)).all() and ((1 / down > 1.10) & (1 / down < 1.24)).all()
+    assert len(set(np.round(factors.numpy(), 3))) > 32
+
+
+def test_content_warp_changes_only_what_the_content_encoder_hears(trained_run, corpus, tmp_path):
+    model, _ = train.load_checkpoint(trained_run / "final.pt", corpus.template)
+    mel = torch.randn(1, 120, 80)
+    idx = torch.arange(10)[None] * 3 + 40
+    tpl = torch.zeros(1, corpus.template.num_vertices, 3)
+    with torch.no_grad():
+        plain = model(mel, idx, tpl)
+        same = model(mel, idx, tpl, content_mel=mel)
+        heard = model(mel, idx, tpl, content_mel=train.content_warp(mel, __import__("numpy").random.default_rng(1), 1.2, 1.2))
+    assert torch.equal(plain["offsets"], same["offsets"])
+    assert not torch.allclose(plain["content_logits"], heard["content_logits"])
+    out = tmp_path / "warped"
+    common = ["--corpus", str(corpus.root), "--out", str(out), "--steps", "2", "--batch-clips", "2", "--frames", "4",
+              "--content-warp", "1.1", "1.2"]
+    assert train.main(common + ["--frontend", str(trained_run / "final.pt"), "--init", str(trained_run / "final.pt")]) == 0
+    try:
+        train.main(common)
+    except SystemExit as e:
+        assert e.code == 2  # argparse: needs a frozen --frontend
+    else:
+        raise AssertionError("--content-warp without a frozen front-end was accepted")

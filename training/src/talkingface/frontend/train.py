@@ -22,12 +22,13 @@ import torch
 import torch.nn.functional as F
 
 from ..data.datasets import open_dataset
-from ..features import AudioConfig
+from ..features import AudioConfig, warp_mel as warp
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
 from ..phones import BILABIALS, PHONE_INDEX
 from ..train import articulation as art
 from ..train.data import prepare
+from ..train.train import load_frontend
 
 CROP = 300           # Mel frames per crop (3 s)
 WARP = (0.9, 1.1)    # frequency-axis warp factors (vocal-tract length perturbation)
@@ -46,16 +47,6 @@ def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
     if not out:
         raise SystemExit(f"no clips in {folder}: build it with python -m talkingface.frontend.speechset")
     return out
-
-
-def warp(mel: np.ndarray, factor: float) -> np.ndarray:
-    """Stretch the Mel axis by `factor` (> 1: a shorter vocal tract, formants move up), edge values held."""
-    n = mel.shape[1]
-    src = np.clip(np.arange(n) / factor, 0, n - 1)
-    lo = np.floor(src).astype(int)
-    hi = np.minimum(lo + 1, n - 1)
-    w = src - lo
-    return mel[:, lo] * (1 - w) + mel[:, hi] * w
 
 
 def batch(clips, rng, size: int, stride: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -116,16 +107,20 @@ def evaluate(enc: ContentEncoder, clips, num_classes: int, stride: int) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.train", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--speech", type=Path, required=True, help="speech set folder (talkingface.frontend.speechset)")
+    ap.add_argument("--speech", type=Path, nargs="+", required=True,
+                    help="speech set folder(s) (talkingface.frontend.speechset; several seeds are several sets)")
     ap.add_argument("--corpus", type=Path, required=True, help="mesh corpus whose val/test splits measure it")
     ap.add_argument("--out", type=Path, required=True)
-    ap.add_argument("--minutes", type=float, default=30.0)
+    ap.add_argument("--minutes", type=float, default=30.0, help="training time budget (the cosine schedule spans it)")
+    ap.add_argument("--steps", type=int, help="a step budget instead of --minutes (the same run on any machine)")
     ap.add_argument("--batch", type=int, default=16)
     ap.add_argument("--lr", type=float, default=2e-3)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     ap.add_argument("--eval-every", type=int, default=500)
     ap.add_argument("--resume", action="store_true", help="continue from OUT/checkpoint.pt")
+    ap.add_argument("--init", help="start from this front-end (a frontend.pt, or a face checkpoint's content encoder, "
+                    "its Mel normalisation included); a new run: fresh optimiser and schedule")
     ap.add_argument("--no-corpus-train", action="store_true",
                     help="leave out the mesh corpus's train split (by default its speech trains the front-end too)")
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
@@ -138,7 +133,7 @@ def main(argv=None) -> int:
     log = lambda *a: print(*a, file=sys.stderr, flush=True)
 
     cfg, audio = ModelConfig(), AudioConfig()
-    clips = load_speech(args.speech)
+    clips = [c for folder in args.speech for c in load_speech(folder)]
     ds = open_dataset(args.corpus)
     held = {split: [prepare(ds, k, audio) for k in ds.keys(split)] for split in ("val", "test")}
     if not args.no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
@@ -151,6 +146,13 @@ def main(argv=None) -> int:
     enc.norm.mean.copy_(torch.from_numpy(allmel.mean(0)))
     enc.norm.std.copy_(torch.from_numpy(allmel.std(0) + 1e-3))
     del allmel
+    if args.init:
+        init = load_frontend(args.init)
+        arch = {k: cfg.to_dict()[k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")}
+        if any(init["model_config"][k] != v for k, v in arch.items()):
+            raise SystemExit(f"--init: {args.init} has another content encoder than {arch}")
+        enc.load_state_dict(init["content"])
+        log(f"initialised from {args.init} ({init['step']} steps)")
     class_weight = torch.ones(cfg.content_classes)
     class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight
     opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)
@@ -166,7 +168,7 @@ def main(argv=None) -> int:
     def save(path: Path, final: bool = False) -> None:
         payload = {"content": enc.state_dict(), "optimizer": opt.state_dict(), "step": step, "trained_seconds": trained,
                    "history": history, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(), "args": vars(args) | {
-                       "speech": str(args.speech), "corpus": str(args.corpus), "out": str(args.out)}}
+                       "speech": [str(f) for f in args.speech], "corpus": str(args.corpus), "out": str(args.out)}}
         if final:
             payload.pop("optimizer")
         torch.save(payload, path.with_suffix(".tmp"))
@@ -174,9 +176,13 @@ def main(argv=None) -> int:
 
     start = time.time() - trained
     losses = []
-    while (trained := time.time() - start) < 60 * args.minutes:
-        for g in opt.param_groups:  # cosine over the time budget
-            g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(trained / (60 * args.minutes), 1.0))))
+    progress = (lambda: step / args.steps) if args.steps else (lambda: trained / (60 * args.minutes))
+    while True:
+        trained = time.time() - start
+        if progress() >= 1:
+            break
+        for g in opt.param_groups:  # cosine over the budget
+            g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(progress(), 1.0))))
         mel, lab = batch(clips, rng, args.batch, cfg.content_stride)
         logits = forward_augmented(enc, mel, rng)
         k = min(logits.shape[1], lab.shape[1])
@@ -193,7 +199,7 @@ def main(argv=None) -> int:
                             **{f"{s}_{m}": ev[s][m] for s in ev for m in ("frame_accuracy", "bilabial_segments_heard")}})
             log(f"step {step}  loss {history[-1]['loss']:.3f}  val acc {100 * ev['val']['frame_accuracy']:.1f}%  "
                 f"test acc {100 * ev['test']['frame_accuracy']:.1f}%  /p b m/ heard {100 * ev['test']['bilabial_segments_heard']:.1f}%  "
-                f"{step / max(trained, 1e-9):.2f} steps/s  ~{(60 * args.minutes - trained) / 60:.1f} min left")
+                f"{step / max(trained, 1e-9):.2f} steps/s  ~{trained * (1 / max(progress(), 1e-9) - 1) / 60:.1f} min left")
             save(ck_path)
     final = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
     save(ck_path)

@@ -72,11 +72,12 @@ class TalkingFace(nn.Module):
     # -- the whole graph ---------------------------------------------------------------------------
 
     def forward(self, mel: torch.Tensor, mel_index: torch.Tensor, template: torch.Tensor,
-                dense: bool = False, return_attention: bool = False) -> dict:
+                dense: bool = False, return_attention: bool = False, content_mel: torch.Tensor | None = None) -> dict:
         """mel (B, K, n_mels); mel_index (B, T) long, the Mel frame of each animation frame;
-        template (B, N, 3) neutral faces in mm. Returns O, pose, posed y, content logits (and attention)."""
+        template (B, N, 3) neutral faces in mm. Returns O, pose, posed y, content logits (and attention).
+        content_mel: what the content encoder hears instead of `mel` (training: a voice it has not heard)."""
         B, T = mel_index.shape
-        logits = self.content(mel)                                             # (B, Kc, D)
+        logits = self.content(mel if content_mel is None else content_mel)     # (B, Kc, D)
         windows = self.content_windows(logits, mel_index)                      # (B, T, W, D)
         tokens = self.hierarchical(windows.flatten(0, 1))                      # (B*T, N, d)
         pose_feat, _ = self.pose_encoder(mel)                                  # (B, K, d)
