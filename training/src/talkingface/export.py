@@ -40,6 +40,18 @@ MANIFEST_FORMAT = "talking-face-model"
 OPSET = 17
 
 
+class _Hierarchical(nn.Module):
+    """The hierarchical feature for the exported face: its shape input (template_input models) baked in."""
+
+    def __init__(self, model, template_mm: torch.Tensor):
+        super().__init__()
+        self.hierarchical = model.hierarchical
+        self.register_buffer("delta", model.template_delta(template_mm))
+
+    def forward(self, window):
+        return self.hierarchical(window, self.delta)
+
+
 class _PoseLSTM(nn.Module):
     def __init__(self, pe):
         super().__init__()
@@ -151,7 +163,9 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
     _onnx(model.content, (mel,), out / "content_encoder.onnx", ["mel"], ["logits"], {"mel": {1: "K"}, "logits": {1: "Kc"}})
     files["content_encoder"] = "content_encoder.onnx"
     win = torch.rand(3, cfg.window, cfg.content_classes)
-    _onnx(model.hierarchical, (win,), out / "hierarchical.onnx", ["windows"], ["tokens"], {"windows": {0: "F"}, "tokens": {0: "F"}})
+    hierarchical = _Hierarchical(model, torch.from_numpy(template.vertices * template.to_millimetres()).float()[None]) \
+        if model.shape_input else model.hierarchical
+    _onnx(hierarchical, (win,), out / "hierarchical.onnx", ["windows"], ["tokens"], {"windows": {0: "F"}, "tokens": {0: "F"}})
     files["hierarchical"] = "hierarchical.onnx"
     _onnx(_PoseConv(model.pose_encoder), (mel,), out / "pose_conv.onnx", ["mel"], ["conv"], {"mel": {1: "K"}, "conv": {1: "K"}})
     files["pose_conv"] = "pose_conv.onnx"

@@ -15,3 +15,24 @@ def test_the_dilated_encoder_looks_back_not_ahead():
         changed = torch.nonzero((enc(moved) - base).abs().amax(-1)[0] > 0).flatten()
     assert 150 - int(changed[0]) * 2 <= 7          # 70 ms look-ahead, as the first encoder
     assert int(changed[-1]) * 2 - 150 >= 50         # and half a second of context behind
+
+
+def test_the_shape_input_reads_how_the_face_differs_from_the_reference(make, template):
+    """It starts at zero (a model gains it without changing), then each face's own shape changes its tokens;
+    the reference face itself reads the same as no face given (what the browser's export bakes in)."""
+    model = make()
+    assert model.shape_input and "reference" in model.state_dict()
+    mm = template.to_millimetres()
+    ref = torch.from_numpy(template.vertices * mm).float()[None]
+    other = ref * 1.05                                                         # a face 5% larger
+    win = torch.rand(2, model.cfg.window, model.cfg.content_classes)
+    h = model.hierarchical
+    torch.testing.assert_close(h(win, model.template_delta(other)), h(win, None), rtol=0, atol=0)
+    torch.nn.init.normal_(h.shape_in.weight)
+    torch.nn.init.normal_(h.shape_in.bias)
+    torch.testing.assert_close(h(win, model.template_delta(ref)), h(win, None), rtol=0, atol=0)
+    assert (h(win, model.template_delta(other)) - h(win, None)).abs().max() > 1e-3
+    mel = torch.randn(150, 80)
+    a, b = model.animate(mel, ref[0], 40), model.animate(mel, other[0], 40)
+    assert (a["offsets"] - b["offsets"]).abs().max() > 1e-3                   # the face changes what the model does
+    assert not make(template_input=False).shape_input and not make(features="G").shape_input

@@ -7,7 +7,7 @@ from ..phones import CONTENT_CLASSES
 
 
 # Values that fields added later had implicitly before they existed (what an older checkpoint means).
-LEGACY = {"content_arch": "conv4"}
+LEGACY = {"content_arch": "conv4", "template_input": False}
 
 
 @dataclass(frozen=True)
@@ -23,6 +23,9 @@ class ModelConfig:
     content_arch: str = "dilated" # "dilated": residual dilated convolutions reading 550 ms back, 70 ms ahead (issue 14);
                                   # "conv4": the first encoder, four convolutions reading 70 ms each way
     content_channels: int = 128   # content encoder width
+    template_input: bool = True   # vertex tokens also read how the subject's neutral face differs from the reference face
+                                  # (encoders.HierarchicalFeature): how far lips must travel to close depends on the face;
+                                  # only with the local feature (features L or LG)
     window: int = 16              # W: content frames per animation frame (paper: 16)
     window_future: int = 1        # of which after the frame: 1 x 20 ms + the encoder reach (70 ms) + half a Mel frame = 106 ms look-ahead
                                   # (3 gave 146 ms, leaving no room in the 150 ms streaming budget, README)

@@ -80,7 +80,14 @@ class HierarchicalFeature(nn.Module):
     """A window of phone posteriors -> one token per vertex: f_h,j = f_g + f_l,j (Sec. III-C, summed).
 
     f_g: an MLP of the whole window. f_l,j: a vertex-conditioned MLP, W2 gelu(W1 a + e_j), so every
-    vertex reads its own latent movement from the same audio at the cost of one d-vector per vertex."""
+    vertex reads its own latent movement from the same audio at the cost of one d-vector per vertex.
+
+    With cfg.template_input, e_j becomes e_j + S (x_j - r_j): x the subject's neutral face, r the reference face
+    the model was trained around (mm). The displacement that closes the lips is the neutral face's own lip gap,
+    which differs from face to face (4.6 to 7.3 mm in the corpus); a model that hears only audio closes an
+    average gap: measured, the shipped model pressed the lips of the val split's narrow-gapped subjects together
+    (-0.3 mm) and left the test split's wide-gapped ones 0.7 mm apart on well-heard /p b m/ (issue 14). S starts at
+    zero. For the reference face itself the term is the constant S's bias, so the browser's graph is unchanged."""
 
     def __init__(self, cfg: ModelConfig, num_vertices: int):
         super().__init__()
@@ -95,15 +102,24 @@ class HierarchicalFeature(nn.Module):
             self.local_in = nn.Linear(inp, d)
             self.vertex_embedding = nn.Parameter(torch.randn(num_vertices, d) * 0.5)
             self.local_out = nn.Linear(d, d)
+        self.shape_in = None
+        if cfg.template_input and self.use_local:  # (a global-only feature has no per-vertex term to add it to)
+            self.shape_in = nn.Linear(3, d)
+            nn.init.zeros_(self.shape_in.weight)
+            nn.init.zeros_(self.shape_in.bias)
         self.num_vertices = num_vertices
 
-    def forward(self, window: torch.Tensor) -> torch.Tensor:
-        """(B, W, D) posteriors -> (B, N, d) tokens."""
+    def forward(self, window: torch.Tensor, delta: torch.Tensor | None = None) -> torch.Tensor:
+        """(B, W, D) posteriors -> (B, N, d) tokens. delta: (B or 1, N, 3) the neutral face minus the reference
+        face in mm (template_input models; None: the reference face itself)."""
         flat = window.flatten(1)                                               # (B, W*D)
         tokens = 0
         if self.use_local:
             a = self.local_in(flat)[:, None, :]                                # (B, 1, d)
-            tokens = self.local_out(torch.nn.functional.gelu(a + self.vertex_embedding[None]))  # (B, N, d)
+            e = self.vertex_embedding[None]                                    # (1, N, d)
+            if self.shape_in is not None:
+                e = e + (self.shape_in.bias if delta is None else self.shape_in(delta))
+            tokens = self.local_out(torch.nn.functional.gelu(a + e))           # (B, N, d)
         if self.use_global:
             g = self.global_mlp(flat)[:, None, :]                              # (B, 1, d)
             tokens = tokens + g if self.use_local else g.expand(-1, self.num_vertices, -1)

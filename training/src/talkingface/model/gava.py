@@ -34,6 +34,9 @@ class TalkingFace(nn.Module):
         self.register_buffer("nbr_pad", pad, persistent=False)                 # (N, K) True = padding
         self.register_buffer("dense_mask", gava_dense_mask(table, pad), persistent=False)  # (N+1, N+1)
 
+        self.shape_input = cfg.template_input and "L" in cfg.features
+        if self.shape_input:  # the face the model's shape input is relative to (mm), saved with the weights
+            self.register_buffer("reference", torch.from_numpy(template.vertices * template.to_millimetres()).float())
         self.content = ContentEncoder(cfg, audio.n_mels)
         self.hierarchical = HierarchicalFeature(cfg, n)
         self.pose_encoder = PoseEncoder(cfg, audio.n_mels)
@@ -44,6 +47,10 @@ class TalkingFace(nn.Module):
         nn.init.zeros_(self.pose_head.bias)
 
     # -- stages ------------------------------------------------------------------------------------
+
+    def template_delta(self, template: torch.Tensor) -> torch.Tensor | None:
+        """(B, N, 3) neutral faces in mm -> their difference from the reference face (None: no shape input)."""
+        return template - self.reference if self.shape_input else None
 
     def content_windows(self, logits: torch.Tensor, mel_index: torch.Tensor) -> torch.Tensor:
         """(B, Kc, D) logits, (B, T) Mel-frame index of each animation frame -> (B, T, W, D) posteriors.
@@ -79,7 +86,8 @@ class TalkingFace(nn.Module):
         B, T = mel_index.shape
         logits = self.content(mel if content_mel is None else content_mel)     # (B, Kc, D)
         windows = self.content_windows(logits, mel_index)                      # (B, T, W, D)
-        tokens = self.hierarchical(windows.flatten(0, 1))                      # (B*T, N, d)
+        delta = self.template_delta(template)                                  # (B, N, 3) or None
+        tokens = self.hierarchical(windows.flatten(0, 1), None if delta is None else delta.repeat_interleave(T, 0))  # (B*T, N, d)
         pose_feat, _ = self.pose_encoder(mel)                                  # (B, K, d)
         pose_token = torch.gather(pose_feat, 1, mel_index[..., None].expand(-1, -1, pose_feat.shape[-1]))  # (B, T, d)
         offsets, pose, maps = self.decode(tokens, pose_token.flatten(0, 1), dense, return_attention)
@@ -104,7 +112,7 @@ class TalkingFace(nn.Module):
         offsets, poses, maps = [], [], []
         for a in range(0, n_frames, chunk):
             mi = idx[a : a + chunk]
-            tokens = self.hierarchical(self.content_windows(logits, mi[None])[0])        # (c, N, d)
+            tokens = self.hierarchical(self.content_windows(logits, mi[None])[0], self.template_delta(template[None]))  # (c, N, d)
             o, p, m = self.decode(tokens, pose_feat[0, mi], return_attention=return_attention)
             offsets.append(o)
             poses.append(p)

@@ -93,6 +93,8 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--content-warp", type=float, nargs=2, metavar=("LO", "HI"),
                     help="with a frozen --frontend: the content encoder hears each crop with its Mel axis warped by a "
                     "factor between LO and HI (or its inverse), a voice it has not heard (see content_warp)")
+    ap.add_argument("--no-template-input", action="store_true",
+                    help="vertex tokens without the subject's neutral-face shape (encoders.HierarchicalFeature; the paper's)")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -150,7 +152,8 @@ def main(argv=None) -> int:
     frontend = load_frontend(args.frontend) if args.frontend else None
     content_cfg = {k: frontend["model_config"][k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")} \
         if frontend else {}
-    cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant, **content_cfg)
+    cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant,
+                      template_input="L" in args.features and not args.no_template_input, **content_cfg)
     t0 = time.time()
     clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
@@ -173,10 +176,14 @@ def main(argv=None) -> int:
         log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
     if args.init:
         init = torch.load(args.init, map_location="cpu", weights_only=False)
-        if init["model_config"] != cfg.to_dict():
+        init_cfg = ModelConfig.from_dict(init["model_config"]).to_dict()
+        gains_shape = not init_cfg["template_input"] and cfg.template_input  # a model without the shape input gains it, at zero
+        if init_cfg | ({"template_input": True} if gains_shape else {}) != cfg.to_dict():
             raise SystemExit(f"--init: {args.init} is a {init['model_config']} model, not {cfg.to_dict()}")
-        model.load_state_dict(init["model"])
-        log(f"initialised from {args.init} (step {init['step']})")
+        missing, unexpected = model.load_state_dict(init["model"], strict=not gains_shape)
+        if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference") for k in missing):
+            raise SystemExit(f"--init: {args.init} does not fit: missing {missing}, unexpected {unexpected}")
+        log(f"initialised from {args.init} (step {init['step']}){', the shape input added at zero' if gains_shape else ''}")
     opt = torch.optim.Adam([p for p in model.parameters() if p.requires_grad], lr=args.lr)
     step, trained_seconds = 0, 0.0
     ck_path = out / "checkpoint.pt"
