@@ -1,0 +1,85 @@
+"""Why a model misses /p b m/ closures: per subject, the neutral face's lip gap, how often the front-end heard the
+segment, and how often the lips closed when it did; and closure against the front-end's confidence.
+
+  scripts/py -m talkingface.train.closure_causes --corpus data/corpus --checkpoint models/checkpoint.pt --split val
+
+Heard: a P, B or M argmax at a content frame of the segment; closed: inner-lip gap < 1 mm at one of its frames
+(the definitions of evaluate.py / articulation.py).
+"""
+from __future__ import annotations
+
+import argparse
+import collections
+import sys
+
+import numpy as np
+import torch
+
+from ..data.datasets import open_dataset
+from ..phones import BILABIALS, PHONES
+from . import articulation as art
+from .data import prepare
+from .train import load_checkpoint
+
+
+def segments(model, ds, split: str) -> list[dict]:
+    bil = [PHONES.index(p) for p in BILABIALS]
+    rate = model.audio.feature_rate / model.cfg.content_stride
+    rows = []
+    for key in ds.keys(split):
+        c = prepare(ds, key, model.audio)
+        out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
+        gap = art.inner_lip_gap(out["unposed"].numpy(), ds.template)
+        face_gap = float(art.inner_lip_gap(c.template[None], ds.template)[0])
+        post = out["logits"].softmax(-1).numpy()
+        for p, a, b in c.segments:
+            if p not in BILABIALS:
+                continue
+            frames = art.segment_frames(a, b, ds.fps, len(gap))
+            k0 = int(a * rate)
+            k1 = max(k0 + 1, int(np.ceil(b * rate)))
+            rows.append({"subject": ds.subject_of(key), "face_gap": face_gap,
+                         "heard": bool(np.isin(post[k0:k1].argmax(-1), bil).any()),
+                         "confidence": float(post[k0:k1][:, bil].sum(-1).max()) if k1 <= len(post) else 0.0,
+                         "closed": bool(gap[frames].min() < art.CLOSED_MM), "min_gap": float(gap[frames].min())})
+    return rows
+
+
+def report(rows: list[dict]) -> list[str]:
+    lines = ["| subject | neutral lip gap (mm) | /p b m/ | heard | closed | closed when heard | median smallest gap when heard (mm) |",
+             "| --- | --- | --- | --- | --- | --- | --- |"]
+    by = collections.defaultdict(list)
+    for r in rows:
+        by[r["subject"]].append(r)
+    for s, rs in sorted(by.items()):
+        h = [r for r in rs if r["heard"]]
+        lines.append(f"| {s} | {rs[0]['face_gap']:.2f} | {len(rs)} | {np.mean([r['heard'] for r in rs]):.0%} | "
+                     f"{np.mean([r['closed'] for r in rs]):.0%} | {np.mean([r['closed'] for r in h]):.0%} | "
+                     f"{np.median([r['min_gap'] for r in h]):.2f} |")
+    lines += ["", "| front-end's largest P+B+M posterior in the segment | segments | closed | median smallest gap (mm) |",
+              "| --- | --- | --- | --- |"]
+    for lo, hi in ((0, .3), (.3, .5), (.5, .7), (.7, .9), (.9, 1.01)):
+        sel = [r for r in rows if lo <= r["confidence"] < hi]
+        if sel:
+            lines.append(f"| {lo:.1f}-{min(hi, 1):.1f} | {len(sel)} | {np.mean([r['closed'] for r in sel]):.0%} | "
+                         f"{np.median([r['min_gap'] for r in sel]):.2f} |")
+    return lines
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.train.closure_causes", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--corpus", required=True)
+    ap.add_argument("--checkpoint", required=True)
+    ap.add_argument("--split", default="val")
+    args = ap.parse_args(argv)
+    torch.set_num_threads(1)
+    ds = open_dataset(args.corpus)
+    model, _ = load_checkpoint(args.checkpoint, ds.template)
+    model.eval()
+    print("\n".join(report(segments(model, ds, args.split))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
