@@ -20,7 +20,7 @@ def test_the_dilated_encoder_looks_back_not_ahead():
 def test_the_shape_input_reads_how_the_face_differs_from_the_reference(make, template):
     """It starts at zero (a model gains it without changing), then each face's own shape changes its tokens;
     the reference face itself reads the same as no face given (what the browser's export bakes in)."""
-    model = make()
+    model = make(template_input=True)
     assert model.shape_input and "reference" in model.state_dict()
     mm = template.to_millimetres()
     ref = torch.from_numpy(template.vertices * mm).float()[None]
@@ -35,4 +35,4 @@ def test_the_shape_input_reads_how_the_face_differs_from_the_reference(make, tem
     mel = torch.randn(150, 80)
     a, b = model.animate(mel, ref[0], 40), model.animate(mel, other[0], 40)
     assert (a["offsets"] - b["offsets"]).abs().max() > 1e-3                   # the face changes what the model does
-    assert not make(template_input=False).shape_input and not make(features="G").shape_input
+    assert not make().shape_input and not make(template_input=True, features="G").shape_input

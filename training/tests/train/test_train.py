@@ -112,8 +112,8 @@ def test_content_warp_changes_only_what_the_content_encoder_hears(trained_run, c
 def test_init_from_a_model_without_the_shape_input_adds_it_at_zero(corpus, tmp_path):
     old, new = tmp_path / "old", tmp_path / "new"
     common = ["--corpus", str(corpus.root), "--batch-clips", "2", "--frames", "4", "--steps", "1"]
-    assert train.main(common + ["--out", str(old), "--no-template-input"]) == 0
-    assert train.main(common + ["--out", str(new), "--init", str(old / "final.pt"), "--lr", "1e-12"]) == 0
+    assert train.main(common + ["--out", str(old)]) == 0
+    assert train.main(common + ["--out", str(new), "--init", str(old / "final.pt"), "--lr", "1e-12", "--template-input"]) == 0
     a, b = (torch.load(p / "final.pt", weights_only=False) for p in (old, new))
     assert not a["model_config"]["template_input"] and b["model_config"]["template_input"]
     assert "hierarchical.shape_in.weight" not in a["model"] and "reference" in b["model"]

@@ -23,7 +23,7 @@ class ModelConfig:
     content_arch: str = "dilated" # "dilated": residual dilated convolutions reading 550 ms back, 70 ms ahead (issue 14);
                                   # "conv4": the first encoder, four convolutions reading 70 ms each way
     content_channels: int = 128   # content encoder width
-    template_input: bool = True   # vertex tokens also read how the subject's neutral face differs from the reference face
+    template_input: bool = False  # vertex tokens also read how the subject's neutral face differs from the reference face
                                   # (encoders.HierarchicalFeature): how far lips must travel to close depends on the face;
                                   # only with the local feature (features L or LG)
     window: int = 16              # W: content frames per animation frame (paper: 16)

@@ -93,8 +93,11 @@ def parse_args(argv=None) -> argparse.Namespace:
     ap.add_argument("--content-warp", type=float, nargs=2, metavar=("LO", "HI"),
                     help="with a frozen --frontend: the content encoder hears each crop with its Mel axis warped by a "
                     "factor between LO and HI (or its inverse), a voice it has not heard (see content_warp)")
-    ap.add_argument("--no-template-input", action="store_true",
-                    help="vertex tokens without the subject's neutral-face shape (encoders.HierarchicalFeature; the paper's)")
+    ap.add_argument("--template-input", action="store_true",
+                    help="vertex tokens also read the subject's neutral face (encoders.HierarchicalFeature; not the paper's, "
+                    "not yet shown better: docs/results/README.md)")
+    ap.add_argument("--shape-lr-scale", type=float, default=1.0,
+                    help="with --template-input: the shape layer's learning rate over --lr (it starts at zero in a fine-tune)")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -153,7 +156,7 @@ def main(argv=None) -> int:
     content_cfg = {k: frontend["model_config"][k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")} \
         if frontend else {}
     cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant,
-                      template_input="L" in args.features and not args.no_template_input, **content_cfg)
+                      template_input="L" in args.features and args.template_input, **content_cfg)
     t0 = time.time()
     clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
@@ -184,7 +187,9 @@ def main(argv=None) -> int:
         if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference") for k in missing):
             raise SystemExit(f"--init: {args.init} does not fit: missing {missing}, unexpected {unexpected}")
         log(f"initialised from {args.init} (step {init['step']}){', the shape input added at zero' if gains_shape else ''}")
-    opt = torch.optim.Adam([p for p in model.parameters() if p.requires_grad], lr=args.lr)
+    shape = [p for n, p in model.named_parameters() if n.startswith("hierarchical.shape_in.")]
+    rest = [p for n, p in model.named_parameters() if p.requires_grad and not n.startswith("hierarchical.shape_in.")]
+    opt = torch.optim.Adam([{"params": rest, "scale": 1.0}] + ([{"params": shape, "scale": args.shape_lr_scale}] if shape else []), lr=args.lr)
     step, trained_seconds = 0, 0.0
     ck_path = out / "checkpoint.pt"
     if args.resume:
@@ -232,7 +237,7 @@ def main(argv=None) -> int:
         # Cosine decay over the budget (steps, or time when the budget is minutes).
         progress = step / budget_steps if budget_steps else trained_seconds / (60 * args.minutes)
         for g in opt.param_groups:
-            g["lr"] = args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
+            g["lr"] = g.get("scale", 1.0) * args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
         b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
         heard = content_warp(b.mel, rng, *args.content_warp) if args.content_warp else None
         out_ = net(b.mel, b.mel_index, b.template, content_mel=heard)
