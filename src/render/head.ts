@@ -35,7 +35,7 @@ export class Head {
   readonly hinge: Hinge;
   /** The face's measures (head-shell.ts): what the neck, shoulders and camera are sized from. */
   readonly measures: FaceMeasures;
-  /** Skin colours of the joined buffer (face, shell; the cavity's are unused). */
+  /** Vertex colours of the joined buffer (face, shell; white for the cavity, which its material colours). */
   readonly colors: Float32Array;
   /** The jaw's opening at the last setFace (radians; 0 = the template's). */
   jawAngle = 0;
@@ -67,9 +67,13 @@ export class Head {
     geometry.setAttribute('position', this.positions);
     this.colors = new Float32Array(all.length);
     this.colors.set(headColors(t, this.shell?.positions ?? null, this.shell?.egg ?? null));
+    this.colors.fill(1, (this.n + S) * 3); // the cavity's: white, its material gives the colour (materials.ts)
     geometry.setAttribute('color', new THREE.BufferAttribute(this.colors.slice(), 3));
     const skinTris = this.shell ? [...t.triangles, ...this.shell.triangles] : [...t.triangles];
+    // The cavity is seen from inside: its triangles are turned to face inwards, so that it is drawn from the front
+    // with the skin's shader program (one program fewer to link on the first draw; materials.ts).
     const bagTris = this.bag ? [...this.bag.triangles] : [];
+    for (let i = 0; i < bagTris.length; i += 3) [bagTris[i + 1], bagTris[i + 2]] = [bagTris[i + 2], bagTris[i + 1]];
     geometry.setIndex([...skinTris, ...bagTris]);
     geometry.addGroup(0, skinTris.length, 0);
     if (bagTris.length) geometry.addGroup(skinTris.length, bagTris.length, 1);
@@ -105,13 +109,14 @@ export class Head {
     const neck = new THREE.Mesh(new THREE.CylinderGeometry(0.66 * m.halfWidth, 0.74 * m.halfWidth, 0.72 * H, 28, 4, true), this.skin.material[0]);
     neck.name = 'neck';
     neck.scale.z = 1.05;
-    neck.geometry.setAttribute('color', new THREE.BufferAttribute(neckColors(neck.geometry), 3));
+    neck.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(neck.geometry, SKIN), 3));
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
     this.group.add(this.skin, this.eyes.left, this.eyes.right, upper, this.jaw, neck);
 
     const body = new THREE.Mesh(new THREE.SphereGeometry(1, 48, 24, 0, Math.PI * 2, 0, Math.PI * 0.62), clothMaterial());
+    body.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(body.geometry, WHITE), 3));
     body.name = 'shoulders';
     body.scale.set(2.3 * m.halfWidth, 0.62 * H, 1.05 * m.halfWidth);
     body.position.set(m.centerX, m.chin - 1.1 * H, m.sideZ - 0.3 * m.halfWidth);
@@ -182,10 +187,11 @@ export class Head {
   }
 }
 
-/** The neck's colour: the skin's, one colour per vertex (the skin material reads vertex colours). */
-function neckColors(g: THREE.BufferGeometry): Float32Array {
+/** One colour for every vertex of `g`: the neck's skin, or white where the material gives the colour (the shoulders). */
+function plainColors(g: THREE.BufferGeometry, color: THREE.Color): Float32Array {
   const n = g.getAttribute('position').count;
   const c = new Float32Array(n * 3);
-  for (let i = 0; i < n; i++) SKIN.toArray(c, 3 * i);
+  for (let i = 0; i < n; i++) color.toArray(c, 3 * i);
   return c;
 }
+const WHITE = new THREE.Color(1, 1, 1);
