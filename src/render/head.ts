@@ -35,7 +35,7 @@ export class Head {
   readonly hinge: Hinge;
   /** The face's measures (head-shell.ts): what the neck, shoulders and camera are sized from. */
   readonly measures: FaceMeasures;
-  /** Vertex colours of the joined buffer (face, shell; white for the cavity, which its material colours). */
+  /** Skin colours of the joined buffer (face, shell; the cavity's are unused). */
   readonly colors: Float32Array;
   /** The jaw's opening at the last setFace (radians; 0 = the template's). */
   jawAngle = 0;
@@ -67,13 +67,9 @@ export class Head {
     geometry.setAttribute('position', this.positions);
     this.colors = new Float32Array(all.length);
     this.colors.set(headColors(t, this.shell?.positions ?? null, this.shell?.egg ?? null));
-    this.colors.fill(1, (this.n + S) * 3); // the cavity's: white, its material gives the colour (materials.ts)
     geometry.setAttribute('color', new THREE.BufferAttribute(this.colors.slice(), 3));
     const skinTris = this.shell ? [...t.triangles, ...this.shell.triangles] : [...t.triangles];
-    // The cavity is seen from inside: its triangles are turned to face inwards, so that it is drawn from the front
-    // with the skin's shader program (one program fewer to link on the first draw; materials.ts).
     const bagTris = this.bag ? [...this.bag.triangles] : [];
-    for (let i = 0; i < bagTris.length; i += 3) [bagTris[i + 1], bagTris[i + 2]] = [bagTris[i + 2], bagTris[i + 1]];
     geometry.setIndex([...skinTris, ...bagTris]);
     geometry.addGroup(0, skinTris.length, 0);
     if (bagTris.length) geometry.addGroup(skinTris.length, bagTris.length, 1);
