@@ -111,6 +111,9 @@ class PageRunner implements Runner {
  * is built and drawn meanwhile (issue 18, first load). Each request is one message: nothing waits on a reply from
  * the page's thread but the result itself. One worker per page, started with the engine's load.
  */
+/** How long onnxruntime's worker may take to answer its first message before the sessions go to the page instead. */
+const WORKER_START_MS = 15_000;
+
 class OrtWorker {
   private static shared: OrtWorker | null = null;
   /** Resolves when the worker has answered its first message; rejects if it could not start. */
@@ -122,9 +125,17 @@ class OrtWorker {
   private constructor(private readonly worker: Worker) {
     let onStarted: () => void = () => undefined;
     this.started = new Promise<void>((resolve, reject) => {
-      onStarted = resolve;
+      const timer = setTimeout(() => {
+        this.fail(new Error(`onnxruntime's worker did not start within ${WORKER_START_MS / 1000} s`));
+        reject(this.failure);
+      }, WORKER_START_MS);
+      onStarted = () => {
+        clearTimeout(timer);
+        resolve();
+      };
       worker.onerror = (e) => {
         e.preventDefault();
+        clearTimeout(timer);
         this.fail(new Error(e.message || "onnxruntime's worker could not start"));
         reject(this.failure);
       };
