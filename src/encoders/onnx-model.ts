@@ -140,6 +140,9 @@ class OrtWorker {
         reject(this.failure);
       };
     });
+    // Deliberate: the outcome is read where a session is asked for (OnnxModel.runner); a worker that fails before
+    // then must not be an unhandled rejection.
+    this.started.catch(() => undefined);
     worker.onmessage = (e: MessageEvent<{ type?: string; id?: number; error?: string }>) => {
       const m = e.data;
       if (m.type === 'started') return onStarted();
