@@ -1,9 +1,11 @@
 /**
- * The one module that owns onnxruntime-web: session creation, execution-provider choice, input checks,
- * and serialised runs (onnxruntime-web sessions must not run concurrently).
+ * The one module that owns onnxruntime-web (with its worker, onnx-worker.ts): session creation, execution-provider
+ * choice, input checks, and serialised runs (onnxruntime-web sessions must not run concurrently). The wasm
+ * provider's sessions live in onnxruntime's own worker where the page can start one, else in the page.
  *
- * onnxruntime-web is imported dynamically: a static import plus numThreads > 1 in a production build
- * makes its worker load the whole app bundle and fail ("document is not defined"; platform.md).
+ * In the page onnxruntime-web is imported dynamically: a static import plus numThreads > 1 in a production build
+ * makes its worker load the whole app bundle and fail ("document is not defined"; platform.md). The worker's own
+ * chunk imports it statically: that chunk holds nothing of the page.
  * Threads need cross-origin isolation (COOP/COEP); an embedding page may not have it, so the
  * sessions then run single-threaded.
  */

@@ -86,8 +86,8 @@ export class TalkingFaceEngine {
   private constructor(private readonly pipeline: Pipeline) {}
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
-    // Each ONNX session is created as soon as its file has arrived (the first one starts onnxruntime's download and
-    // compile), while the others are still on their way: the model is ready sooner than if every file were awaited first.
+    // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
+    // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
     const gpu = detectWebGPU().then((support) => {
       const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
