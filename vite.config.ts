@@ -17,6 +17,23 @@ const ORT_VERSION = JSON.parse(readFileSync(resolve(ORT_DIST, '../package.json')
 const ORT_FILES = ['ort-wasm-simd-threaded.mjs', 'ort-wasm-simd-threaded.wasm', 'ort-wasm-simd-threaded.jsep.mjs', 'ort-wasm-simd-threaded.jsep.wasm'];
 
 /**
+ * The demo's first load (issue 18): the files the page will fetch first, named in its HTML so that the browser asks
+ * for them together with the app's script instead of one after another (manifest -> template header -> template
+ * binary, and the model files only once the script has run). The list comes from models/manifest.json, the one
+ * place that names them; each link matches the page's own fetch() (same origin, crossorigin), so nothing is
+ * fetched twice.
+ */
+function modelPreloads(): { tag: string; attrs: Record<string, string | boolean>; injectTo: 'head' }[] {
+  const manifest = JSON.parse(readFileSync(resolve(MODELS_DIR, 'manifest.json'), 'utf8')) as {
+    files: Record<string, string>; runtime_files: string[]; template: { path: string };
+  };
+  const template = JSON.parse(readFileSync(resolve(MODELS_DIR, manifest.template.path), 'utf8')) as { binary: string };
+  const templateDir = manifest.template.path.replace(/[^/]*$/, '');
+  const paths = ['manifest.json', manifest.template.path, templateDir + template.binary, ...manifest.runtime_files.map((k) => manifest.files[k])];
+  return paths.map((p) => ({ tag: 'link', attrs: { rel: 'preload', href: `/models/${p}`, as: 'fetch', crossorigin: true }, injectTo: 'head' }));
+}
+
+/**
  * Serve models/ at /models/ and onnxruntime-web's files at /ort/<version>/ in dev, copy both into the build, and
  * serve the build in preview as a static host should (scripts/hosting.ts: precompressed files, cache headers).
  */
@@ -52,6 +69,7 @@ function modelsDir(): Plugin {
     configurePreviewServer(server) {
       server.middlewares.use(serveBuild(outDir));
     },
+    transformIndexHtml: { order: 'post', handler: (_html, ctx) => (ctx.path === '/index.html' ? modelPreloads() : []) },
     closeBundle() {
       cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true, preserveTimestamps: true });
       for (const f of ORT_FILES) cpSync(resolve(ORT_DIST, f), resolve(outDir, 'ort', ORT_VERSION, f), { preserveTimestamps: true });

@@ -11,7 +11,7 @@
 import { fetchArtefacts, type ArtefactOptions } from '../model/artefacts';
 import type { Manifest } from '../model/manifest';
 import { parseSafetensors } from '../model/safetensors';
-import { loadOrt, ortBuildFor, type ExecutionProvider } from '../encoders/onnx-model';
+import { sessionsRequested, startOrt, type ExecutionProvider } from '../encoders/onnx-model';
 import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
@@ -71,20 +71,33 @@ export interface AnimateOptions {
   signal?: AbortSignal;
 }
 
+let markSessionsRequested: () => void = () => undefined;
+
 export class TalkingFaceEngine {
+  /**
+   * Resolves once load() has asked onnxruntime for every session of the model: where the page can start a worker,
+   * onnxruntime creates them there, and the page's main thread is free for work of its own meanwhile.
+   */
+  static readonly sessionsRequested: Promise<void> = new Promise((resolve) => (markSessionsRequested = resolve));
+
   private reference: ReferenceDecoder | null = null;
   private rest: Promise<Float32Array> | null = null;
 
   private constructor(private readonly pipeline: Pipeline) {}
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
-    // Each ONNX session is created as soon as its file has arrived (the first one starts onnxruntime's download and
-    // compile), while the others are still on their way: the model is ready sooner than if every file were awaited first.
+    // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
+    // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
-    const [support, { manifest, template, files }] = await Promise.all([detectWebGPU(), fetchArtefacts(options)]);
+    const gpu = detectWebGPU().then((support) => {
+      const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
+      const providers: ExecutionProvider[] = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
+      startOrt(providers); // onnxruntime (its worker, or its script) loads while the files arrive
+      return { support, providers };
+    });
+    const [{ support, providers }, { manifest, template, files }] = await Promise.all([gpu, fetchArtefacts(options)]);
     const m = manifest.model.config;
-    const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
-    const providers = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
+    void sessionsRequested(manifest.runtime_files.filter((k) => manifest.onnx[k]).length).then(markSessionsRequested);
     // The decoder's weights and the head's own motion come from the same file.
     const weights = files.decoder_weights.then((bytes) => {
       const tensors = parseSafetensors(bytes).tensors;
@@ -97,7 +110,6 @@ export class TalkingFaceEngine {
       decoders,
       template,
       weights,
-      loadOrt(ortBuildFor(providers)), // onnxruntime's script now, while the files arrive
     ]);
     const pipeline = new Pipeline(manifest, face, content, pose, decoder, head && new HeadMotion(head, m.d_model));
     if (options.headMotionSeed !== undefined) pipeline.headSeed = options.headMotionSeed;

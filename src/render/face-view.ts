@@ -81,6 +81,7 @@ export class FaceView {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
     this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
     this.model = new Head(template);
+    shareTongueProgram(this.model);
     this.head = this.model.group;
     this.scene.add(this.head, this.model.body);
     this.environment = lightScene(this.scene, this.renderer);
@@ -318,5 +319,22 @@ export class FaceView {
     this.camera.position.sub(t).setLength(distance).add(t);
     this.controls.update();
     this.requestRender();
+  }
+}
+
+/**
+ * The teeth carry the tongue's one morph target, at zero everywhere: three.js then draws teeth and tongue with one
+ * shader program, and the first draw links one program fewer (under a software GPU each costs tens of milliseconds
+ * of the first frame; issue 18). Only the view does this: the .glb export's teeth have no morph target.
+ */
+function shareTongueProgram(head: Head): void {
+  const targets = head.tongue.geometry.morphAttributes.position?.length ?? 0;
+  for (const name of ['teeth_upper', 'teeth_lower']) {
+    const teeth = head.group.getObjectByName(name) as THREE.Mesh | undefined;
+    if (!teeth || targets === 0) continue;
+    const count = teeth.geometry.getAttribute('position').count;
+    teeth.geometry.morphAttributes.position = Array.from({ length: targets }, () => new THREE.BufferAttribute(new Float32Array(count * 3), 3));
+    teeth.geometry.morphTargetsRelative = head.tongue.geometry.morphTargetsRelative;
+    teeth.updateMorphTargets();
   }
 }

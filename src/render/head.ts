@@ -105,13 +105,14 @@ export class Head {
     const neck = new THREE.Mesh(new THREE.CylinderGeometry(0.66 * m.halfWidth, 0.74 * m.halfWidth, 0.72 * H, 28, 4, true), this.skin.material[0]);
     neck.name = 'neck';
     neck.scale.z = 1.05;
-    neck.geometry.setAttribute('color', new THREE.BufferAttribute(neckColors(neck.geometry), 3));
+    neck.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(neck.geometry, SKIN), 3));
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
     this.group.add(this.skin, this.eyes.left, this.eyes.right, upper, this.jaw, neck);
 
     const body = new THREE.Mesh(new THREE.SphereGeometry(1, 48, 24, 0, Math.PI * 2, 0, Math.PI * 0.62), clothMaterial());
+    body.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(body.geometry, WHITE), 3));
     body.name = 'shoulders';
     body.scale.set(2.3 * m.halfWidth, 0.62 * H, 1.05 * m.halfWidth);
     body.position.set(m.centerX, m.chin - 1.1 * H, m.sideZ - 0.3 * m.halfWidth);
@@ -182,10 +183,11 @@ export class Head {
   }
 }
 
-/** The neck's colour: the skin's, one colour per vertex (the skin material reads vertex colours). */
-function neckColors(g: THREE.BufferGeometry): Float32Array {
+/** One colour for every vertex of `g`: the neck's skin, or white where the material gives the colour (the shoulders). */
+function plainColors(g: THREE.BufferGeometry, color: THREE.Color): Float32Array {
   const n = g.getAttribute('position').count;
   const c = new Float32Array(n * 3);
-  for (let i = 0; i < n; i++) SKIN.toArray(c, 3 * i);
+  for (let i = 0; i < n; i++) color.toArray(c, 3 * i);
   return c;
 }
+const WHITE = new THREE.Color(1, 1, 1);

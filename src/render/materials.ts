@@ -41,7 +41,10 @@ function reflectEnvironment(root: THREE.Object3D, environment: THREE.Texture): v
 }
 const REFLECTIVE = new Set(['eye', 'teeth', 'tongue']);
 
-/** The inside of the mouth: dark, wet and reddish; seen from inside (its back faces). */
+/**
+ * The inside of the mouth: dark, wet and reddish; seen from inside (its back faces). Its own shader program (drawn
+ * from both sides): its rim is the face's own lip vertices, whose normals turning the cavity inwards would change.
+ */
 export function cavityMaterial(): THREE.MeshStandardMaterial {
   return new THREE.MeshStandardMaterial({ name: 'mouth', color: 0x2e0e12, roughness: 0.8, side: THREE.DoubleSide });
 }
@@ -55,7 +58,9 @@ export function tongueMaterial(): THREE.MeshStandardMaterial {
 }
 
 export function clothMaterial(): THREE.MeshStandardMaterial {
-  return new THREE.MeshStandardMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85 });
+  // White vertex colours (head.ts), read like the skin's: three.js then draws the cloth with the skin's shader
+  // program, and the first draw links one program fewer (under a software GPU each costs tens of ms; issue 18).
+  return new THREE.MeshStandardMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85, vertexColors: true });
 }
 
 /**
