@@ -65,7 +65,7 @@ async function start(): Promise<void> {
   // model's sessions are handed to onnxruntime's worker first, which creates them meanwhile (a failed load does not
   // hold the face back, nor do files still on their way after FACE_WAITS_MS: on a slow connection the face comes first).
   const waited = new Promise((resolve) => setTimeout(resolve, FACE_WAITS_MS));
-  await Promise.race([TalkingFaceEngine.sessionsRequested, engineReady.catch(() => undefined), waited]);
+  await Promise.race([TalkingFaceEngine.sessionsRequested, engineReady.catch(() => undefined), waited]); // a failure is read by the await below
   lastGpu = gpu;
   view = new FaceView(ui.canvas, face, { lifePaused: true }); // still until the model is ready (face-view.ts)
   player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });

@@ -144,7 +144,7 @@ class OrtWorker {
     });
     // Deliberate: the outcome is read where a session is asked for (OnnxModel.runner); a worker that fails before
     // then must not be an unhandled rejection.
-    this.started.catch(() => undefined);
+    this.started.catch(() => undefined); // read where a session is asked for
     worker.onmessage = (e: MessageEvent<{ type?: string; id?: number; error?: string }>) => {
       const m = e.data;
       if (m.type === 'started') return onStarted();

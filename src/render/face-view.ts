@@ -18,6 +18,7 @@ import { Head } from './head';
 import { blinkField } from './eyelids';
 import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
+import { shareTongueProgram } from './mouth-interior';
 import { pickFaceVertex, poseArrows } from './overlays';
 
 export interface FaceViewOptions {
@@ -319,22 +320,5 @@ export class FaceView {
     this.camera.position.sub(t).setLength(distance).add(t);
     this.controls.update();
     this.requestRender();
-  }
-}
-
-/**
- * The teeth carry the tongue's one morph target, at zero everywhere: three.js then draws teeth and tongue with one
- * shader program, and the first draw links one program fewer (under a software GPU each costs tens of milliseconds
- * of the first frame; issue 18). Only the view does this: the .glb export's teeth have no morph target.
- */
-function shareTongueProgram(head: Head): void {
-  const targets = head.tongue.geometry.morphAttributes.position?.length ?? 0;
-  for (const name of ['teeth_upper', 'teeth_lower']) {
-    const teeth = head.group.getObjectByName(name) as THREE.Mesh | undefined;
-    if (!teeth || targets === 0) continue;
-    const count = teeth.geometry.getAttribute('position').count;
-    teeth.geometry.morphAttributes.position = Array.from({ length: targets }, () => new THREE.BufferAttribute(new Float32Array(count * 3), 3));
-    teeth.geometry.morphTargetsRelative = head.tongue.geometry.morphTargetsRelative;
-    teeth.updateMorphTargets();
   }
 }

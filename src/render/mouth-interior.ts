@@ -187,3 +187,20 @@ export function tongueGeometry(f: MouthFrame): THREE.BufferGeometry {
   g.morphTargetsRelative = true;
   return g;
 }
+
+/**
+ * The teeth carry the tongue's one morph target, at zero everywhere: three.js then draws teeth and tongue with one
+ * shader program, and the first draw links one program fewer (under a software GPU each costs tens of milliseconds
+ * of the first frame; issue 18). Only the view does this: the .glb export's teeth have no morph target.
+ */
+export function shareTongueProgram(head: { tongue: THREE.Mesh; group: THREE.Object3D }): void {
+  const targets = head.tongue.geometry.morphAttributes.position?.length ?? 0;
+  for (const name of ['teeth_upper', 'teeth_lower']) {
+    const teeth = head.group.getObjectByName(name) as THREE.Mesh | undefined;
+    if (!teeth || targets === 0) continue;
+    const count = teeth.geometry.getAttribute('position').count;
+    teeth.geometry.morphAttributes.position = Array.from({ length: targets }, () => new THREE.BufferAttribute(new Float32Array(count * 3), 3));
+    teeth.geometry.morphTargetsRelative = head.tongue.geometry.morphTargetsRelative;
+    teeth.updateMorphTargets();
+  }
+}
