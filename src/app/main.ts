@@ -58,14 +58,14 @@ async function start(): Promise<void> {
     if (m instanceof Error) throw m;
     return TalkingFaceEngine.load({ ...m, template });
   });
-  // Deliberate: the outcome is read below (await engineReady); this only keeps an early failure from being "unhandled".
-  engineReady.catch(() => undefined); // read by the await below
+  // Settled either way; a failure is read below (await engineReady) and is not "unhandled" meanwhile.
+  const engineSettled = engineReady.catch(() => undefined); // read by the await below
   const [face, gpu] = await Promise.all([template, gpuReady]);
   // Building and drawing the face holds this thread for most of a second under a software GPU (issue 18): the
   // model's sessions are handed to onnxruntime's worker first, which creates them meanwhile (a failed load does not
   // hold the face back, nor do files still on their way after FACE_WAITS_MS: on a slow connection the face comes first).
   const waited = new Promise((resolve) => setTimeout(resolve, FACE_WAITS_MS));
-  await Promise.race([TalkingFaceEngine.sessionsRequested, engineReady.catch(() => undefined), waited]); // a failure is read by the await below
+  await Promise.race([TalkingFaceEngine.sessionsRequested, engineSettled, waited]);
   lastGpu = gpu;
   view = new FaceView(ui.canvas, face, { lifePaused: true }); // still until the model is ready (face-view.ts)
   player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });

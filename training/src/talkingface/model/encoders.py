@@ -86,7 +86,8 @@ class HierarchicalFeature(nn.Module):
     the model was trained around (mm). The displacement that closes the lips is the neutral face's own lip gap,
     which differs from face to face (4.6 to 7.3 mm in the corpus); a model that hears only audio closes an
     average gap: measured, the shipped model pressed the lips of the val split's narrow-gapped subjects together
-    (-0.3 mm) and left the test split's wide-gapped ones 0.7 mm apart on well-heard /p b m/ (issue 14). S starts at
+    (median smallest gap -0.42 / -0.11 mm on heard /p b m/) and left the test split's wide-gapped ones 0.38 / 0.56 mm
+    apart (train.closure_causes; issue 14). Fine-tunes with it have not helped yet (docs/results/README.md). S starts at
     zero. For the reference face itself the term is the constant S's bias, so the browser's graph is unchanged."""
 
     def __init__(self, cfg: ModelConfig, num_vertices: int):

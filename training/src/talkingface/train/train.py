@@ -115,9 +115,10 @@ def content_warp(mel: torch.Tensor, rng: np.random.Generator, lo: float, hi: flo
     A frozen front-end hears the mesh corpus's training voices far better than voices it has never heard
     (measured on the shipped one: frame accuracy 82% on train clips, 64% on the test split's held-out voices).
     A decoder trained on its confident train posteriors learns to close the lips only on a confident P; on a
-    new voice it then misses bilabials the front-end did hear (86% heard, 66% closed). A warp of 1.2 brings
-    the train clips to the held-out voices' accuracy (66%), so the decoder learns to read the posteriors it
-    will get from a stranger."""
+    new voice it might then miss bilabials the front-end did hear. A warp of 1.2 brings the train clips to the
+    held-out voices' accuracy (66%), so the decoder learns to read the posteriors it will get from a stranger.
+    Tried on the shipped model, it did not help: the decoder already closes what it hears on the val split
+    (docs/results/README.md, "Tried next")."""
     out = mel.clone()
     for b in range(mel.shape[0]):
         f = rng.uniform(lo, hi)
