@@ -16,6 +16,7 @@ import { levelAt } from '../encoders/voice-activity';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
 import type { Frames, StageTimes } from './frames';
 import { AvatarWeights } from '../avatar/weights';
+import { LipClosure } from './lip-closure';
 import type { SolverState } from '../avatar/solver';
 
 /** Frames per chunk when the caller does not say: bounds memory and the WebGPU decoder's buffers. */
@@ -34,6 +35,7 @@ export class Pipeline {
   /** The seed of the head's own motion (new states draw with it); null: the pose head's mean pose alone. */
   headSeed: number | null = 0;
   private avatar: AvatarWeights | null = null;
+  private closure: LipClosure | null | undefined;
 
   constructor(
     readonly manifest: Manifest,
@@ -80,6 +82,13 @@ export class Pipeline {
     const state: ProducerState = this.pose.newState();
     if (options.blendshapes) state.blendshapes = this.avatarWeights.newState();
     return state;
+  }
+
+  /** The model's closure on the face's own lip gap (null: a model exported without it), built on first use. */
+  get lipClosure(): LipClosure | null {
+    const c = this.manifest.lip_closure;
+    if (this.closure === undefined) this.closure = c ? new LipClosure(this.template, c.reference_gap_mm) : null;
+    return this.closure;
   }
 
   /** The avatar stage, built on first use (the ARKit basis of the template: a few hundred ms). */
@@ -135,6 +144,7 @@ export class Pipeline {
     this.times.decoder += performance.now() - t;
 
     t = performance.now();
+    this.lipClosure?.apply(decoded.offsets, melIndex.length, this.template.vertexCount);
     if (this.headMotion && this.headSeed !== null) {
       state.head ??= this.headMotion.start(this.headSeed);
       const residual = this.headMotion.residuals(state.head, f0, poseToken, melIndex.length);

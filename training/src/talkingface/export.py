@@ -31,6 +31,7 @@ import torch.nn as nn
 from .fixtures import fixture_audio, write_fixtures
 from .model.gava import TalkingFace
 from .model.head_motion import HeadMotion
+from .model.lip_closure import LipClosure
 from .paths import MODELS_DIR
 from .phones import CONTENT_CLASSES
 from .safetensors import sha256, write_safetensors
@@ -188,7 +189,9 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
     files["decoder_weights"] = "gava.safetensors"
 
     template_mm = (template.vertices * mm_per_unit).astype(np.float32)
-    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head)
+    closure = ck.get("lip_closure")
+    closer = LipClosure(template, template_mm, closure["reference_gap_mm"]) if closure else None
+    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head, closer)
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}
         torch.save(slim, out / "checkpoint.pt")
@@ -212,6 +215,11 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
         "head_motion": ({"tensors": "head_motion.* in gava.safetensors", "default_seed": 0,
                          "process": "r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
                         if head is not None else None),
+        "lip_closure": ({"reference_gap_mm": float(closure["reference_gap_mm"]), "calibrated_on": closure.get("split"),
+                         "rule": "at each x across the mouth, c = clamp(-(du - dl) / g_ref(x), 0, 1) of the model's offsets; the lips "
+                                 "close by c (g(x) - g_ref(x)) more, with the rig's lip fields; g the face's gap, g_ref = g * reference / lip gap "
+                                 "(training/src/talkingface/model/lip_closure.py)"}
+                        if closure else None),
         "heads": {"displacement": "Linear(d, 3), mm", "pose": f"Linear(d, 6): rotation = {cfg.max_rotation} tanh(x[0:3]) (axis-angle, rad), translation = {cfg.max_translation_mm} tanh(x[3:6]) mm; y = R (I + O) + t"},
         "files": all_files,
         "runtime_files": runtime,

@@ -20,9 +20,12 @@ FIXTURE_TOKEN_FRAMES = 2  # frames whose tokens and per-layer outputs are kept
 
 
 @torch.no_grad()
-def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path, head_motion=None) -> dict:
+def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path, head_motion=None,
+                   lip_closure=None) -> dict:
     """Every intermediate tensor of one short clip, from the same code paths the browser mirrors; with the head's
-    own motion (model/head_motion.py) when given: its residuals for seed 0, and the poses and vertices with it."""
+    own motion (model/head_motion.py) when given: its residuals for seed 0, and the poses and vertices with it;
+    with the lip closure (model/lip_closure.py) when given: the offsets it gives the template's face, and those
+    of a face with its lips parted 1.5 mm further (the lower lip's tissue lowered), so the test sees both ways."""
     a = model.audio
     mel = log_mel(audio, a)                                                    # (K, n_mels)
     n_frames = int(round(len(audio) / a.sample_rate * a.fps))
@@ -57,6 +60,16 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
         sampled = compose(pose.numpy(), residual, head_motion.pivot_mm)
         tensors |= {"head_residual": residual.astype(np.float32), "pose_sampled": sampled,
                     "vertices_sampled": apply_pose(torch.from_numpy(template_mm)[None] + offsets, torch.from_numpy(sampled)).numpy()}
+    if lip_closure is not None:
+        from .model.lip_closure import LipClosure
+        # The clip's frames open the lips; silence closes them (c = 1) and 0.6 of it partly (c < 1): all three cases.
+        silence = model.animate(torch.from_numpy(log_mel(np.zeros(a.sample_rate // 2, np.float32), a)),
+                                torch.from_numpy(template_mm), 4)["offsets"].numpy()
+        lips_in = np.concatenate([offsets.numpy()[:4], silence, 0.6 * silence]).astype(np.float32)
+        wider = template_mm.copy()
+        wider[:, 1] -= 1.5 * lip_closure.lower_weight.astype(np.float32)
+        tensors |= {"lips_in": lips_in, "lips_out": lip_closure.apply(lips_in), "template_wider_mm": wider,
+                    "lips_out_wider": LipClosure(lip_closure.template, wider, lip_closure.reference_gap).apply(lips_in)}
     for i, l in enumerate(layers):
         tensors[f"layer{i}"] = l
     tensors.update(attention)

@@ -3,6 +3,8 @@ segment, and how often the lips closed when it did; and closure against the fron
 
   scripts/py -m talkingface.train.closure_causes --corpus data/corpus --checkpoint models/checkpoint.pt --split val
 
+With the checkpoint's lip closure (model/lip_closure.py) unless --raw.
+
 Heard: a P, B or M argmax at a content frame of the segment; closed: inner-lip gap < 1 mm at one of its frames
 (the definitions of evaluate.py / articulation.py).
 """
@@ -18,18 +20,23 @@ import torch
 from ..data.datasets import open_dataset
 from ..phones import BILABIALS, PHONES
 from . import articulation as art
+from ..model import lip_closure as lc
 from .data import prepare
 from .train import load_checkpoint
 
 
-def segments(model, ds, split: str) -> list[dict]:
+def segments(model, ds, split: str, lip_closure: dict | None = None) -> list[dict]:
+    """`lip_closure`: a checkpoint's retargeting of the closure to each face (model/lip_closure.py), or None."""
     bil = [PHONES.index(p) for p in BILABIALS]
     rate = model.audio.feature_rate / model.cfg.content_stride
     rows = []
     for key in ds.keys(split):
         c = prepare(ds, key, model.audio)
         out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
-        gap = art.inner_lip_gap(out["unposed"].numpy(), ds.template)
+        offsets = out["offsets"].numpy()
+        if lip_closure:
+            offsets = lc.from_checkpoint({"lip_closure": lip_closure}, ds.template, c.template).apply(offsets)
+        gap = art.inner_lip_gap(c.template[None] + offsets, ds.template)
         face_gap = float(art.inner_lip_gap(c.template[None], ds.template)[0])
         post = out["logits"].softmax(-1).numpy()
         for p, a, b in c.segments:
@@ -72,12 +79,15 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", required=True)
     ap.add_argument("--checkpoint", required=True)
     ap.add_argument("--split", default="val")
+    ap.add_argument("--raw", action="store_true", help="the model's offsets as they are, without the checkpoint's lip closure")
+    ap.add_argument("--reference-gap", type=float, help="retarget the closure with this reference gap (mm) instead of the checkpoint's")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
     ds = open_dataset(args.corpus)
-    model, _ = load_checkpoint(args.checkpoint, ds.template)
+    model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
-    print("\n".join(report(segments(model, ds, args.split))))
+    closure = None if args.raw else {"reference_gap_mm": args.reference_gap} if args.reference_gap else ck.get("lip_closure")
+    print("\n".join(report(segments(model, ds, args.split, closure))))
     return 0
 
 

@@ -21,6 +21,7 @@ from ..features import frame_to_mel_index, log_mel
 from ..geometry.contours import lip_gap
 from ..geometry.pose import apply_pose as apply_pose_np
 from ..model import head_motion as hmodel
+from ..model import lip_closure as lc
 from . import articulation as art
 from . import head_motion as hm
 from .data import prepare
@@ -28,11 +29,15 @@ from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
 
 
-def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0) -> dict:
+def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0,
+             lip_closure: float | None = None) -> dict:
     """The paper's metrics and the articulation and head-motion measures on `split`. `head`: the head's own motion
-    (model/head_motion.py), drawn with `seed` and added to the predicted pose as the browser does; None: the mean pose."""
+    (model/head_motion.py), drawn with `seed` and added to the predicted pose as the browser does; None: the mean pose.
+    `lip_closure`: the reference gap (mm) that retargets the closure to each face as the browser does
+    (model/lip_closure.py); None: the model's offsets as they are."""
     model.eval()
     t = ds.template
+    closers: dict[bytes, lc.LipClosure] = {}
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
     per_clip, artic, heads = [], [], []
     D = model.cfg.content_classes
@@ -44,6 +49,12 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         mel = torch.from_numpy(c.mel)
         out = model.animate(mel, torch.from_numpy(c.template), c.num_frames)
         pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
+        if lip_closure is not None:
+            face = c.template.tobytes()
+            if face not in closers:
+                closers[face] = lc.LipClosure(t, c.template, lip_closure)
+            pred_unposed = c.template[None] + closers[face].apply(out["offsets"].numpy())
+            pred_posed = apply_pose_np(pred_unposed, pred_pose)
         if head is not None:
             feats, _ = hmodel.clip_features(model, c.mel, c.num_frames)
             # Clip i draws with seed + i: one seed would give every clip the same draws, and the measures one sample.
@@ -86,17 +97,20 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     head = {"all": hm.summarise(heads), "synthetic": hm.summarise([r for r in heads if r["source"] != "human"]),
             "human": hm.summarise([r for r in heads if r["source"] == "human"])}
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
-            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t),
+            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure),
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
 
-def silence_probe(model, template) -> dict:
+def silence_probe(model, template, lip_closure: float | None = None) -> dict:
     """Two seconds of digital silence: how far apart does the model leave the inner lips (mm)?
     The corpus rig closes them in silence (about 0.4 mm, docs/corpus)."""
     mm = template.to_millimetres()
     tpl = torch.from_numpy(template.vertices * mm)
     out = model.animate(torch.from_numpy(log_mel(np.zeros(2 * model.audio.sample_rate, np.float32), model.audio)), tpl, 2 * model.audio.fps)
-    gap = lip_gap(out["unposed"].numpy(), template)
+    offsets = out["offsets"].numpy()
+    if lip_closure is not None:
+        offsets = lc.LipClosure(template, tpl.numpy(), lip_closure).apply(offsets)
+    gap = lip_gap(tpl.numpy()[None] + offsets, template)
     neutral = lip_gap(tpl[None].numpy(), template)[0]
     return {"lip_gap_mean_mm": float(gap.mean()), "lip_gap_max_mm": float(gap.max()), "neutral_template_gap_mm": float(neutral)}
 
@@ -110,13 +124,16 @@ def main(argv=None) -> int:
     ap.add_argument("--out", help="write the results JSON here")
     ap.add_argument("--head-seed", type=int, default=0, help="seed of the head's own motion (clip i draws with seed + i; when the checkpoint has one)")
     ap.add_argument("--mean-pose", action="store_true", help="measure the pose head's mean pose alone, without the head's own motion")
+    ap.add_argument("--raw-lips", action="store_true", help="the model's offsets as they are, without the checkpoint's lip closure")
     args = ap.parse_args(argv)
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
     t0 = time.time()
     heads: list = []
     head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
-    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed)
+    closure = ck["lip_closure"]["reference_gap_mm"] if "lip_closure" in ck and not args.raw_lips else None
+    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure)
+    res["lip_closure"] = {"reference_gap_mm": closure} if closure is not None else None
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
     res["head_motion"]["sampled"] = {"seed": args.head_seed} if head is not None else None
@@ -156,7 +173,12 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
         "",
         f"Checkpoint `{args.checkpoint}`: {ck['step']} steps, {ck['trained_seconds'] / 60:.1f} min of training "
         f"({ck.get('world_size', 1)} process(es)). Made by",
-        f"`scripts/py -m talkingface.train.evaluate --corpus {args.corpus} --checkpoint {args.checkpoint} --split {args.split} --out {args.out}`.",
+        f"`scripts/py -m talkingface.train.evaluate --corpus {args.corpus} --checkpoint {args.checkpoint} --split {args.split} --out {args.out}"
+        f"{' --raw-lips' if getattr(args, 'raw_lips', False) else ''}`.",
+        "",
+        (f"Lip closure retargeted to each face's own lip gap (reference gap {res['lip_closure']['reference_gap_mm']:.3f} mm, "
+         "`training/src/talkingface/model/lip_closure.py`), as the browser does." if res.get("lip_closure") else
+         "The model's offsets as they are (no lip closure retargeting)."),
         "",
         "Errors in mm. E_vl / E_ve: mean over frames of the largest lip / eye vertex error on the unposed face (Eq. 8);",
         "E_vl posed: the same with the predicted head pose applied. FDD (Eq. 9, signed) and AFDD (Eq. 10) on the upper face.",

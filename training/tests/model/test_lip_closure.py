@@ -1,0 +1,47 @@
+"""The lip closure (model/lip_closure.py): a model's full closure shuts any face's lips; openings are left alone."""
+import numpy as np
+
+from talkingface.corpus.identity import apply_identity, sample_subject
+from talkingface.corpus.rig import Rig
+from talkingface.corpus.visemes import P, PARAMS
+from talkingface.geometry.contours import lip_gap
+from talkingface.model.lip_closure import LipClosure, interpolation_matrix
+
+
+def _offsets(rig: Rig, **params) -> np.ndarray:
+    p = np.zeros((1, len(PARAMS)))
+    for k, v in params.items():
+        p[0, P[k]] = v
+    return rig.deform(p, np.zeros(1), np.zeros(1)) - rig.rest[None]
+
+
+def test_interpolation_matrix_is_np_interp():
+    xs = np.array([-2.0, -0.5, 0.0, 1.5])
+    x = np.array([-3.0, -2.0, -1.0, 0.7, 1.5, 4.0])
+    ys = np.array([1.0, -2.0, 0.5, 3.0])
+    assert np.allclose(interpolation_matrix(x, xs) @ ys, np.interp(x, xs, ys))
+
+
+def test_a_full_closure_shuts_any_face_and_an_opening_is_the_models(template):
+    mm = template.to_millimetres()
+    ref_face = template.vertices * mm
+    ref_gap = float(lip_gap(ref_face[None], template)[0])
+    # The reference face's own closure and jaw opening stand in for a model trained on it.
+    ref_rig = Rig(template, ref_face)
+    closing, opening = _offsets(ref_rig, close=1.0), _offsets(ref_rig, jaw=1.0)
+    rng = np.random.default_rng(3)
+    faces = [apply_identity(template, sample_subject(f"S{i}", rng).identity) * mm for i in range(6)]
+    gaps = [float(lip_gap(f[None], template)[0]) for f in faces]
+    assert max(gaps) - min(gaps) > 0.8  # the faces part their lips by different amounts
+    for face, g in zip(faces, gaps):
+        lc = LipClosure(template, face, ref_gap)
+        raw = lip_gap(face[None] + closing, template)[0]
+        shut = lip_gap(face[None] + lc.apply(closing), template)[0]
+        if abs(g - ref_gap) > 0.3:  # as the model closes: pressed through on a smaller gap, apart on a larger one
+            assert np.sign(raw) == np.sign(g - ref_gap) and abs(raw) > 0.1
+        assert abs(shut) < 0.1
+        assert np.allclose(lc.apply(opening), opening)
+    # Half a closure closes half of each face's own gap.
+    lc = LipClosure(template, faces[int(np.argmax(gaps))], ref_gap)
+    half = lip_gap(faces[int(np.argmax(gaps))][None] + lc.apply(0.5 * closing), template)[0]
+    assert abs(half - 0.5 * max(gaps)) < 0.15
