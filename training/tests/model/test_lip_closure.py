@@ -45,3 +45,19 @@ def test_a_full_closure_shuts_any_face_and_an_opening_is_the_models(template):
     lc = LipClosure(template, faces[int(np.argmax(gaps))], ref_gap)
     half = lip_gap(faces[int(np.argmax(gaps))][None] + lc.apply(0.5 * closing), template)[0]
     assert abs(half - 0.5 * max(gaps)) < 0.15
+
+
+def test_the_torch_version_is_the_same_and_passes_gradients(template):
+    import torch
+    from talkingface.model.lip_closure import LipClosureTorch
+    mm = template.to_millimetres()
+    face = apply_identity(template, sample_subject("T", np.random.default_rng(5)).identity) * mm
+    lc = LipClosure(template, face, 5.0)
+    closing = _offsets(Rig(template, face), close=0.8)
+    o = np.concatenate([closing, np.random.default_rng(0).normal(0, 1.5, (3, template.num_vertices, 3))]).astype(np.float32)
+    t = torch.from_numpy(o).requires_grad_(True)
+    out = LipClosureTorch(lc).apply(t)
+    assert np.abs(out.detach().numpy() - lc.apply(o)).max() < 1e-4
+    assert np.abs(out.detach().numpy() - o).max() > 0.1
+    out[..., 1].sum().backward()
+    assert torch.isfinite(t.grad).all() and t.grad.abs().sum() > 0

@@ -118,3 +118,13 @@ def test_init_from_a_model_without_the_shape_input_adds_it_at_zero(corpus, tmp_p
     assert not a["model_config"]["template_input"] and b["model_config"]["template_input"]
     assert "hierarchical.shape_in.weight" not in a["model"] and "reference" in b["model"]
     assert b["model"]["hierarchical.shape_in.weight"].abs().max() < 1e-6
+
+
+def test_training_with_the_lip_closure_in_the_loss_records_its_reference(corpus, tmp_path):
+    """--lip-closure trains with each face's closure retargeted (model/lip_closure.py) and keeps the reference gap,
+    which evaluate, closure_causes and export read; the calibration command replaces it later."""
+    out = tmp_path / "lips"
+    assert train.main(["--corpus", str(corpus.root), "--out", str(out), "--steps", "2", "--batch-clips", "2", "--frames", "4",
+                       "--lip-closure", "5.5"]) == 0
+    ck = torch.load(out / "final.pt", weights_only=False)
+    assert ck["lip_closure"]["reference_gap_mm"] == 5.5

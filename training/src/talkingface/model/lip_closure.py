@@ -77,6 +77,35 @@ class LipClosure:
         return o.astype(np.asarray(offsets).dtype)
 
 
+class LipClosureTorch:
+    """The same retargeting as differentiable torch ops, for training with it in the loss (train.py --lip-closure):
+    the model then learns how far to close (c), and each face's own gap sets how far that is."""
+
+    def __init__(self, lc: LipClosure):
+        import torch
+        a = lc.active
+        f32 = lambda x: torch.as_tensor(np.asarray(x), dtype=torch.float32)
+        self.upper, self.lower, self.active = (torch.as_tensor(i) for i in (lc.upper, lc.lower, a))
+        self.A_up, self.A_lo = f32(lc.A_up[a].T), f32(lc.A_lo[a].T)            # (U, |a|), (L, |a|)
+        self.gap, self.ref, self.field = f32(lc.gap[a]), f32(lc.ref[a]), f32(lc.field[a])
+
+    def apply(self, offsets):
+        """(..., N, 3) offsets in mm -> the same, retargeted (a new tensor; gradients flow through c)."""
+        y = offsets[..., 1]
+        d = y[..., self.upper] @ self.A_up - y[..., self.lower] @ self.A_lo
+        c = (-d / self.ref).clamp(0.0, 1.0)
+        dy = offsets.new_zeros(offsets.shape[:-1])
+        dy = dy.index_add(-1, self.active, c * (self.gap - self.ref) * self.field)
+        return offsets + torch_stack_y(dy)
+
+
+def torch_stack_y(dy):
+    """(..., N) -> (..., N, 3) with dy in y."""
+    import torch
+    z = torch.zeros_like(dy)
+    return torch.stack([z, dy, z], -1)
+
+
 def reference_gap(ds, split: str = "train") -> tuple[float, int]:
     """Mean neutral inner-lip gap (mm) of the faces in `split`, each face counted once."""
     faces = {}

@@ -23,6 +23,8 @@ import torch.distributed as dist
 
 from ..data.datasets import open_dataset
 from ..features import AudioConfig, warp_mel
+from ..geometry.pose_torch import apply_pose
+from ..model import lip_closure as lc
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from ..paths import REPO_ROOT, TEMPLATE_DIR
@@ -98,6 +100,9 @@ def parse_args(argv=None) -> argparse.Namespace:
                     "not yet shown better: docs/results/README.md)")
     ap.add_argument("--shape-lr-scale", type=float, default=1.0,
                     help="with --template-input: the shape layer's learning rate over --lr (it starts at zero in a fine-tune)")
+    ap.add_argument("--lip-closure", type=float, metavar="MM",
+                    help="train with the closure retargeted to each face's own lip gap in the loss (model/lip_closure.py), "
+                         "this reference gap in mm: the model learns how far to close, the face sets how far that is")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
@@ -220,8 +225,24 @@ def main(argv=None) -> int:
         torch.save({"model": model.state_dict(), "optimizer": opt.state_dict(), "step": step,
                     "trained_seconds": trained_seconds, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(),
                     "template_id": ds.template.id, "template_path": str(Path(args.corpus) / "template" / "template.json")
-                    if args.template is None else args.template, "args": vars(args), "world_size": world}, path.with_suffix(".tmp"))
+                    if args.template is None else args.template, "args": vars(args), "world_size": world}
+                   | ({"lip_closure": {"reference_gap_mm": args.lip_closure, "split": "train (in the loss)"}} if args.lip_closure else {}),
+                   path.with_suffix(".tmp"))
         os.replace(path.with_suffix(".tmp"), path)
+
+    closers: dict[bytes, lc.LipClosureTorch] = {}
+
+    def retarget(out_: dict, faces: torch.Tensor) -> dict:
+        """The model's offsets with the closure on each clip's own face (--lip-closure), posed again."""
+        o = []
+        for i, face in enumerate(faces):
+            key = face.numpy().tobytes()
+            if key not in closers:
+                closers[key] = lc.LipClosureTorch(lc.LipClosure(ds.template, face.numpy(), args.lip_closure))
+            o.append(closers[key].apply(out_["offsets"][i]))
+        o = torch.stack(o)
+        unposed = faces[:, None] + o
+        return {**out_, "offsets": o, "unposed": unposed, "vertices": apply_pose(unposed, out_["pose"])}
 
     history = []
     start = time.time() - trained_seconds
@@ -242,6 +263,8 @@ def main(argv=None) -> int:
         b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
         heard = content_warp(b.mel, rng, *args.content_warp) if args.content_warp else None
         out_ = net(b.mel, b.mel_index, b.template, content_mel=heard)
+        if args.lip_closure:
+            out_ = retarget(out_, b.template)
         loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights, pairs)
         opt.zero_grad(set_to_none=True)
         loss.backward()
