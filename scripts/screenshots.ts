@@ -18,6 +18,14 @@ async function ready(page: Page, attr: string, value: string): Promise<void> {
   await page.waitForSelector(`body[data-${attr}="${value}"]`, { timeout: 120_000 });
 }
 
+/** Choose a sample clip in the demo and wait for its take (a no-op when it is the one shown). */
+async function showSample(page: Page, sample: string): Promise<void> {
+  if ((await page.locator('#sample-select').inputValue()) === sample) return;
+  await page.evaluate(() => { delete document.body.dataset.take; });
+  await page.locator('#sample-select').selectOption(sample);
+  await ready(page, 'take', 'ready');
+}
+
 /** Put the demo's camera at `azimuth` (radians about the target, 0 = front) at `distance` times its current distance; aim at y. */
 async function orbit(page: Page, azimuth: number, distance: number, aimY?: number): Promise<void> {
   await page.evaluate(`(() => {
@@ -45,28 +53,49 @@ async function headViews(browser: Browser): Promise<void> {
   await canvas.screenshot({ path: resolve(OUT, 'head-three-quarter.png') });
   await orbit(page, Math.PI / 2, 1);
   await canvas.screenshot({ path: resolve(OUT, 'head-profile.png') });
-  const sample = (await page.locator('#sample-select option').nth(1).getAttribute('value'))!;
-  await page.locator('#sample-select').selectOption(sample);
-  await ready(page, 'take', 'ready');
-  // The widest-open frame heard as a vowel, and the most closed frame heard as /m/.
-  const frames = (await page.evaluate(`(() => {
+  // Each sample clip's widest-open frame heard as a vowel and most closed frame heard as /p b m/ (the inner-lip gap
+  // as training measures it: src/template/lip-gap.ts); the vowel from the first clip, the closure from the clip that
+  // closes most (the sample clips differ: one /p/ the model misses, docs/results/README.md).
+  const measure = async () => (await page.evaluate(`(() => {
     const tf = globalThis.talkingFace, a = tf.take.animation, r = tf.template.regions, names = tf.engine.manifest.content_phones;
     const n3 = a.unposed.length / a.frames;
-    const up = Array.from(r.lips_inner_upper).filter((v) => !r.lips_inner_lower.includes(v));
-    const lo = Array.from(r.lips_inner_lower).filter((v) => !r.lips_inner_upper.includes(v));
-    const gap = (f) => up.reduce((s, v) => s + a.unposed[f * n3 + 3 * v + 1], 0) / up.length - lo.reduce((s, v) => s + a.unposed[f * n3 + 3 * v + 1], 0) / lo.length;
+    const upper = Array.from(r.lips_inner_upper), lower = Array.from(r.lips_inner_lower);
+    const inner = upper.filter((v) => !lower.includes(v));
+    const gap = (f) => {
+      const x = (v) => a.unposed[f * n3 + 3 * v], y = (v) => a.unposed[f * n3 + 3 * v + 1];
+      const lo = [...lower].sort((p, q) => x(p) - x(q));
+      let best = -Infinity;
+      for (const v of inner) {
+        let k = 0;
+        while (k < lo.length - 2 && x(lo[k + 1]) < x(v)) k++;
+        const t = Math.min(1, Math.max(0, (x(v) - x(lo[k])) / (x(lo[k + 1]) - x(lo[k]) || 1)));
+        best = Math.max(best, y(v) - (y(lo[k]) + t * (y(lo[k + 1]) - y(lo[k]))));
+      }
+      return best;
+    };
     let vowel = 0, m = -1;
     for (let f = 0; f < a.frames; f++) {
       const p = names[a.phones[f]];
       if (/^(AA|AE|AH|AO|AW|AY|EH|ER|EY|IH|IY|OW|OY|UH|UW)$/.test(p) && gap(f) > gap(vowel)) vowel = f;
-      if (p === 'M' && (m < 0 || gap(f) < gap(m))) m = f;
+      if (/^(P|B|M)$/.test(p) && (m < 0 || gap(f) < gap(m))) m = f;
     }
-    return { vowel, m };
-  })()`)) as { vowel: number; m: number };
+    return { vowel, m, mGap: m < 0 ? null : gap(m) / tf.engine.unitsPerMm };
+  })()`)) as { vowel: number; m: number; mGap: number | null };
+  const options = await page.locator('#sample-select option').evaluateAll((os) => os.map((o) => (o as HTMLOptionElement).value).filter(Boolean));
+  let vowel: { sample: string; frame: number } | null = null;
+  let closure: { sample: string; frame: number; gap: number } | null = null;
+  for (const sample of options) {
+    await showSample(page, sample);
+    const f = await measure();
+    vowel ??= { sample, frame: f.vowel };
+    if (f.m >= 0 && (closure === null || f.mGap! < closure.gap)) closure = { sample, frame: f.m, gap: f.mGap! };
+  }
+  if (!vowel || !closure) throw new Error('the sample clips have no vowel or no /p b m/ frame');
+  console.log(`mouth-m.png: ${closure.sample} frame ${closure.frame}, inner-lip gap ${closure.gap.toFixed(2)} mm`);
   const mouthY = await page.evaluate(`(() => { const t = globalThis.talkingFace.template, r = t.regions.lips_outer; return Array.from(r).reduce((s, v) => s + t.positions[3 * v + 1], 0) / r.length; })()`) as number;
   await orbit(page, 0.25, 0.45, mouthY);
-  for (const [name, frame] of [['mouth-vowel.png', frames.vowel], ['mouth-m.png', frames.m]] as const) {
-    if (frame < 0) throw new Error(`the sample clip has no frame for ${name}`);
+  for (const [name, { sample, frame }] of [['mouth-vowel.png', vowel], ['mouth-m.png', closure]] as const) {
+    await showSample(page, sample);
     await page.locator('#scrub').fill(String(frame));
     await page.waitForTimeout(800); // the speech blend
     await canvas.screenshot({ path: resolve(OUT, name) });

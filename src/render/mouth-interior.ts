@@ -143,7 +143,7 @@ function arch(f: MouthFrame, upper: boolean): THREE.BufferGeometry {
   const front = f.frontZ - 0.1 * W - (upper ? 0 : 0.075 * W);
   const depthAt = (x: number) => 0.55 * (x / (0.55 * W)) ** 2 * W;
   const height = (upper ? 0.3 : 0.26) * W;
-  const edge = upper ? f.upperY - 0.05 * W : f.lowerY + 0.02 * W;
+  const edge = upper ? f.upperY - 0.05 * W : f.lowerY - 0.03 * W;
   const parts: THREE.BufferGeometry[] = [];
   for (const side of [-1, 1]) {
     let x = 0;
@@ -154,7 +154,7 @@ function arch(f: MouthFrame, upper: boolean): THREE.BufferGeometry {
       const slope = (2 * 0.55 * mid) / (0.55 * W) ** 2 * W;
       tooth.rotateY(-side * Math.atan(slope));
       // Each crown hangs from (upper) or stands on (lower) the gum line, its biting edge at `edge`.
-      const y = upper ? edge + (height * (k < 3 ? 1 : 0.8)) / 2 + (k >= 3 ? 0.04 * W : 0) : edge - (height * (k < 3 ? 1 : 0.8)) / 2 - (k >= 3 ? 0.04 * W : 0);
+      const y = upper ? edge + (height * (k < 3 ? 1 : 0.8)) / 2 + (k >= 3 ? 0.02 * W : 0) : edge - (height * (k < 3 ? 1 : 0.8)) / 2 - (k >= 3 ? 0.02 * W : 0);
       tooth.translate(f.center[0] + side * mid, y, front - depthAt(mid));
       parts.push(tooth);
     });
