@@ -11,7 +11,8 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../src/gpu/capabilities';
 import { TalkingFaceEngine } from '../src/engine/engine';
-import { OnnxModel, specOf, type ExecutionProvider } from '../src/encoders/onnx-model';
+import { OnnxModel, type ExecutionProvider } from '../src/encoders/onnx-model';
+import { specOf } from '../src/encoders/onnx-spec';
 
 const maxAbsDiff = (a: ArrayLike<number>, b: ArrayLike<number>) => {
   let m = 0;

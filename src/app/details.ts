@@ -4,7 +4,8 @@
  */
 import type { FaceTemplate } from '../template/face-template';
 import type { WebGPUSupport } from '../gpu/capabilities';
-import type { TalkingFaceEngine } from '../engine/engine';
+import type { Backend, TalkingFaceEngine } from '../engine/engine';
+import { tell, ui } from './controls';
 import { simdUnavailable } from '../attention/simd-kernel';
 import { SHORT_CLIP_SECONDS } from '../player/player';
 import type { Take } from './take-view';
@@ -26,4 +27,15 @@ export function takeDetails(t: Take, notes: string[]): string {
     ? 'no speed figure for a clip this short'
     : `${(t.computeMs / t.animation.frames).toFixed(1)} ms per frame, ${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time`;
   return `${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
+}
+
+/** New animations use decoder `want`: say so, and keep the details' decoder line up to date. */
+export function switchBackend(engine: TalkingFaceEngine, want: Backend): void {
+  engine.setBackend(want).then(
+    () => {
+      tell(`New animations will use the ${engine.backend} decoder.`);
+      ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine));
+    },
+    (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),
+  );
 }

@@ -13,7 +13,7 @@ import { Player, audioNotes } from '../player/player';
 import { TakeView, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, type SampleIndex } from './samples';
-import { setupDetails, decoderDetails, takeDetails } from './details';
+import { setupDetails, decoderDetails, switchBackend, takeDetails } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
 import { ui, showStatus, tell, announce, lockWidth, bindControls } from './controls';
@@ -282,16 +282,19 @@ function escape(): boolean {
   return true;
 }
 
+const togglePlay = (): void => (player?.isPlaying ? stopPlayback() : play());
+const showFrame = (frame: number): void => {
+  stopPlayback();
+  player.show(frame);
+};
+
 bindControls({
   openFile: (file) => void animateFile(file),
   openSample: (name) => void openSample(name),
   toggleRecording: () => void toggleRecording(),
   cancel: () => busy?.abort(),
-  togglePlay: () => (player?.isPlaying ? stopPlayback() : play()),
-  seek: (frame) => {
-    stopPlayback();
-    player.show(frame);
-  },
+  togglePlay,
+  seek: showFrame,
   unlockAudio: () => player?.unlock(),
   setLoop: (on) => (player.loop = on),
   setArrows: (on) => takeView.setArrows(on),
@@ -302,17 +305,7 @@ bindControls({
     if (take) player.show(player.current);
   },
   pick: (x, y) => takeView.pick(x, y) && takeView.paint(take, engine, player.current, player.isPlaying),
-  setBackend: (choice) => {
-    if (!engine) return;
-    const want: Backend = choice === 'auto' ? autoBackend : (choice as Backend);
-    engine.setBackend(want).then(
-      () => {
-        tell(`New animations will use the ${engine!.backend} decoder.`);
-        ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine!));
-      },
-      (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),
-    );
-  },
+  setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
   rerollHead: () => void rerollHead(),
@@ -321,11 +314,8 @@ bindControls({
 bindKeys({
   escape,
   hasTake: () => take !== null,
-  togglePlay: () => (player?.isPlaying ? stopPlayback() : play()),
-  step: (delta) => {
-    stopPlayback();
-    player.show(player.current + delta);
-  },
+  togglePlay,
+  step: (delta) => showFrame(player.current + delta),
   orbit: (azimuth, polar) => view?.orbit(azimuth, polar),
   zoom: (factor) => view?.zoom(factor),
 });

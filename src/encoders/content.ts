@@ -5,7 +5,8 @@
  */
 import type { Manifest, ModelConstants } from '../model/manifest';
 import { contentWindows, softmaxRows } from './windows';
-import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
+import { OnnxModel, type ExecutionProvider } from './onnx-model';
+import { specOf } from './onnx-spec';
 import { melFlatness, speechProbabilities } from './voice-activity';
 import { melBandWidths } from '../audio/mel';
 

@@ -11,7 +11,7 @@
  */
 import type * as Ort from 'onnxruntime-web';
 import { ModelLoadError } from '../model/artefacts';
-import type { Manifest } from '../model/manifest';
+import { checkFeeds, type Feeds, type SessionSpec } from './onnx-spec';
 
 export type ExecutionProvider = 'webgpu' | 'wasm';
 
@@ -65,7 +65,6 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
 }
 
 type Outputs = Record<string, { data: Float32Array; dims: readonly number[] }>;
-type Feeds = Record<string, { data: Float32Array | BigInt64Array; shape: number[] }>;
 
 /** A created session wherever it runs: in the page, or in onnxruntime's worker. */
 interface Runner {
@@ -250,24 +249,6 @@ function sessionOptions(provider: ExecutionProvider): Ort.InferenceSession.Sessi
   return { executionProviders: [provider], graphOptimizationLevel: 'all', logSeverityLevel: 3 };
 }
 
-export interface SessionSpec {
-  name: string;
-  bytes: ArrayBuffer;
-  /** Expected input names with their shapes ("K"-style strings are free dimensions). */
-  inputs: Record<string, (number | string)[]>;
-}
-
-/** The session spec of runtime file `key` as the manifest describes it (manifest.onnx[key].inputs). */
-export function specOf(manifest: Manifest, key: string, bytes: ArrayBuffer): SessionSpec {
-  return { name: key, bytes, inputs: manifest.onnx[key].inputs };
-}
-
-/** A dimension's fixed size, or null for a free one ("K", "ceil(K / content_stride)"); "1" is fixed. */
-function fixedSize(dim: number | string): number | null {
-  if (typeof dim === 'number') return dim;
-  return /^\d+$/.test(dim) ? Number(dim) : null;
-}
-
 /** A session plus a queue: `run` calls are executed one after another. */
 export class OnnxModel {
   private queue: Promise<unknown> = Promise.resolve();
@@ -315,19 +296,11 @@ export class OnnxModel {
   }
 
   /** Run with float32 / int64 feeds given as (data, shape); shapes are checked against the manifest first. */
-  run(feeds: Record<string, { data: Float32Array | BigInt64Array; shape: number[] }>): Promise<Record<string, { data: Float32Array; dims: readonly number[] }>> {
-    for (const [name, want] of Object.entries(this.inputs)) {
-      const got = feeds[name];
-      if (!got) throw new RangeError(`${this.name}: missing input ${name}`);
-      const bad = want.length !== got.shape.length || want.some((w, i) => fixedSize(w) !== null && fixedSize(w) !== got.shape[i]);
-      if (bad) throw new RangeError(`${this.name}: input ${name} has shape [${got.shape}], expected [${want}]`);
-      const count = got.shape.reduce((a, b) => a * b, 1);
-      if (count !== got.data.length) throw new RangeError(`${this.name}: input ${name} has ${got.data.length} values for shape [${got.shape}]`);
-    }
+  run(feeds: Feeds): Promise<Record<string, { data: Float32Array; dims: readonly number[] }>> {
+    checkFeeds(this.name, this.inputs, feeds);
     const job = this.queue.then(() => this.runner.run(feeds));
-    // Deliberate: the caller receives the job's error through `job`; the queue only orders runs, and one failed
-    // run must not stop the next.
-    this.queue = job.catch(() => undefined); // the caller gets the error through `job`; the queue only orders runs
+    // One failed run must not stop the next.
+    this.queue = job.catch(() => undefined); // deliberate: the caller gets the error through `job`; the queue only orders runs
     return job;
   }
 

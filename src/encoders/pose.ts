@@ -4,7 +4,8 @@
  * Mel frame. The LSTM advances over every Mel frame exactly once, so chunked and streaming runs equal the whole clip.
  */
 import type { Manifest } from '../model/manifest';
-import { OnnxModel, specOf, type ExecutionProvider } from './onnx-model';
+import { OnnxModel, type ExecutionProvider } from './onnx-model';
+import { specOf } from './onnx-spec';
 
 /** What carries from one chunk to the next: the LSTM's state and the pose features still needed. */
 export interface PoseState {
