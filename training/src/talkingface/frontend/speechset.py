@@ -4,7 +4,8 @@ The content encoder (our DeepSpeech stand-in) learns phones from log-Mel. The me
 speech from a few dozen voices; phone recognition is limited by how many voices it has heard (issue 14), so the
 front-end trains apart from the face, on this set:
 
-- Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds;
+- Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds; with
+  `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices);
 - festival, flite and espeak-ng voices (corpus/speech.py);
 - the recorded human speech of the corpus's train split (one speaker, real microphones).
 
@@ -70,13 +71,19 @@ def texts(n: int, seed: int) -> list[str]:
     return out
 
 
-def plan(minutes: float, seed: int) -> list[SpeechSpec]:
+KOKORO_VOICES = ("english", "accented", "all")
+
+
+def plan(minutes: float, seed: int, kokoro_voices: str = "english") -> list[SpeechSpec]:
+    """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
-    k_voices = kokoro.voice_names()
+    k_voices = (kokoro.voice_names() if kokoro_voices != "accented" else []) + \
+        (kokoro.accented_voice_names() if kokoro_voices != "english" else [])
     if not k_voices:
-        raise kokoro.KokoroMissing("Kokoro is not set up: run `scripts/py -m talkingface.corpus setup --kokoro`")
+        flag = "--kokoro" if kokoro_voices == "english" else "--kokoro --kokoro-accented"
+        raise kokoro.KokoroMissing(f"Kokoro's {kokoro_voices} voices are not set up: run `scripts/py -m talkingface.corpus setup {flag}`")
     classic = [v for v in all_voices() if not is_test_voice(v)]
     humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
@@ -149,9 +156,9 @@ def build_one(args) -> dict:
     return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2}
 
 
-def build(out: Path, minutes: float, seed: int, workers: int) -> dict:
+def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english") -> dict:
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed)
+    specs = plan(minutes, seed, kokoro_voices)
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -180,8 +187,10 @@ def main(argv=None) -> int:
     ap.add_argument("--minutes", type=float, default=120.0, help="planned speech (before skips), minutes")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--kokoro-voices", choices=KOKORO_VOICES, default="english",
+                    help="Kokoro's English voices, its accented ones (setup --kokoro-accented), or all of them")
     args = ap.parse_args(argv)
-    meta = build(args.out, args.minutes, args.seed, args.workers)
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
