@@ -128,3 +128,18 @@ def test_training_with_the_lip_closure_in_the_loss_records_its_reference(corpus,
                        "--lip-closure", "5.5"]) == 0
     ck = torch.load(out / "final.pt", weights_only=False)
     assert ck["lip_closure"]["reference_gap_mm"] == 5.5
+
+
+def test_the_front_end_wins_over_the_initial_weights(trained_run, corpus, tmp_path):
+    """With --frontend and --init from different models, the content encoder is the front-end's (it was the init's)."""
+    other = tmp_path / "other"
+    assert train.main(["--corpus", str(corpus.root), "--out", str(other), "--steps", "1", "--batch-clips", "2", "--frames", "4",
+                       "--seed", "7"]) == 0
+    fe = torch.load(other / "final.pt", weights_only=False)["model"]
+    init = torch.load(trained_run / "final.pt", weights_only=False)["model"]
+    assert any(not torch.equal(fe[k], init[k]) for k in fe if k.startswith("content."))
+    out = tmp_path / "tuned"
+    assert train.main(["--corpus", str(corpus.root), "--out", str(out), "--steps", "2", "--batch-clips", "2", "--frames", "4",
+                       "--frontend", str(other / "final.pt"), "--init", str(trained_run / "final.pt")]) == 0
+    tuned = torch.load(out / "final.pt", weights_only=False)["model"]
+    assert all(torch.equal(tuned[k], fe[k]) for k in fe if k.startswith("content."))

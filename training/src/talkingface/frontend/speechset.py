@@ -156,9 +156,10 @@ def build_one(args) -> dict:
     return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2}
 
 
-def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english") -> dict:
+def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None) -> dict:
+    """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly)."""
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed, kokoro_voices)
+    specs = plan(minutes, seed, kokoro_voices)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -189,8 +190,9 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--kokoro-voices", choices=KOKORO_VOICES, default="english",
                     help="Kokoro's English voices, its accented ones (setup --kokoro-accented), or all of them")
+    ap.add_argument("--first", type=int, help="build only the plan's first N clips (the plan itself is that of --minutes)")
     args = ap.parse_args(argv)
-    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices)
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 

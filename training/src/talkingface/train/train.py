@@ -179,10 +179,6 @@ def main(argv=None) -> int:
     for norm in (model.pose_encoder.norm,) if frontend else (model.content.norm, model.pose_encoder.norm):
         norm.mean.copy_(torch.from_numpy(mean))
         norm.std.copy_(torch.from_numpy(std))
-    if frontend:  # its own Mel normalisation (statistics of its far larger speech set) comes with it
-        model.content.load_state_dict(frontend["content"])
-        model.content.requires_grad_(args.tune_frontend)
-        log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
     if args.init:
         init = torch.load(args.init, map_location="cpu", weights_only=False)
         init_cfg = ModelConfig.from_dict(init["model_config"]).to_dict()
@@ -193,6 +189,11 @@ def main(argv=None) -> int:
         if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference") for k in missing):
             raise SystemExit(f"--init: {args.init} does not fit: missing {missing}, unexpected {unexpected}")
         log(f"initialised from {args.init} (step {init['step']}){', the shape input added at zero' if gains_shape else ''}")
+    # After --init: the front-end replaces the content encoder the initial weights brought.
+    if frontend:  # its own Mel normalisation (statistics of its far larger speech set) comes with it
+        model.content.load_state_dict(frontend["content"])
+        model.content.requires_grad_(args.tune_frontend)
+        log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
     shape = [p for n, p in model.named_parameters() if n.startswith("hierarchical.shape_in.")]
     rest = [p for n, p in model.named_parameters() if p.requires_grad and not n.startswith("hierarchical.shape_in.")]
     opt = torch.optim.Adam([{"params": rest, "scale": 1.0}] + ([{"params": shape, "scale": args.shape_lr_scale}] if shape else []), lr=args.lr)
