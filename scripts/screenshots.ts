@@ -54,25 +54,13 @@ async function headViews(browser: Browser): Promise<void> {
   await orbit(page, Math.PI / 2, 1);
   await canvas.screenshot({ path: resolve(OUT, 'head-profile.png') });
   // Each sample clip's widest-open frame heard as a vowel and most closed frame heard as /p b m/ (the inner-lip gap
-  // as training measures it: src/template/lip-gap.ts); the vowel from the first clip, the closure from the clip that
-  // closes most (the sample clips differ: one /p/ the model misses, docs/results/README.md).
+  // as training measures it: src/template/lip-gap.ts, which the demo publishes); the vowel from the first clip, the
+  // closure from the clip that closes most (the sample clips differ: one /p/ the model misses).
   const measure = async () => (await page.evaluate(`(() => {
     const tf = globalThis.talkingFace, a = tf.take.animation, r = tf.template.regions, names = tf.engine.manifest.content_phones;
-    const n3 = a.unposed.length / a.frames;
-    const upper = Array.from(r.lips_inner_upper), lower = Array.from(r.lips_inner_lower);
-    const inner = upper.filter((v) => !lower.includes(v));
-    const gap = (f) => {
-      const x = (v) => a.unposed[f * n3 + 3 * v], y = (v) => a.unposed[f * n3 + 3 * v + 1];
-      const lo = [...lower].sort((p, q) => x(p) - x(q));
-      let best = -Infinity;
-      for (const v of inner) {
-        let k = 0;
-        while (k < lo.length - 2 && x(lo[k + 1]) < x(v)) k++;
-        const t = Math.min(1, Math.max(0, (x(v) - x(lo[k])) / (x(lo[k + 1]) - x(lo[k]) || 1)));
-        best = Math.max(best, y(v) - (y(lo[k]) + t * (y(lo[k + 1]) - y(lo[k]))));
-      }
-      return best;
-    };
+    const gaps = tf.innerLipGaps(a.unposed, a.frames, a.unposed.length / a.frames / 3,
+      Uint32Array.from(r.lips_inner_upper), Uint32Array.from(r.lips_inner_lower));
+    const gap = (f) => gaps[f];
     let vowel = 0, m = -1;
     for (let f = 0; f < a.frames; f++) {
       const p = names[a.phones[f]];

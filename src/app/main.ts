@@ -18,6 +18,7 @@ import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
 import { ui, showStatus, tell, announce, lockWidth, bindControls } from './controls';
 import { bindKeys } from './keyboard';
+import { innerLipGaps } from '../template/lip-gap';
 
 /** How long the face, once its template is in, waits for the model's files to reach onnxruntime (start()). */
 const FACE_WAITS_MS = 300;
@@ -42,6 +43,7 @@ function publish(): void {
       view, template: view?.template, gpu: lastGpu, engine, take, truthView: takeView?.truthView ?? null,
       exportGlb: async () => (take && engine ? exportGlb(take.animation, view.template, engine.unitsPerMm) : null),
       inspectGlb,
+      innerLipGaps,
     },
   });
 }

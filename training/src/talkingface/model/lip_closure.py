@@ -67,6 +67,12 @@ class LipClosure:
         self.field = 0.5 * (rig.w_lower - rig.w_upper)                  # closing: the upper lip down, the lower up
         self.active = np.flatnonzero((self.field != 0) & (self.gap > MIN_GAP_MM))
 
+    def torch(self) -> "LipClosureTorch":
+        """The same as differentiable torch ops (built once)."""
+        if not hasattr(self, "_torch"):
+            self._torch = LipClosureTorch(self)
+        return self._torch
+
     def apply(self, offsets: np.ndarray) -> np.ndarray:
         """(F, N, 3) the model's offsets in mm -> the same with the lips closed by the face's own gap."""
         o = np.array(offsets, dtype=np.float64, copy=True)
@@ -94,16 +100,23 @@ class LipClosureTorch:
         y = offsets[..., 1]
         d = y[..., self.upper] @ self.A_up - y[..., self.lower] @ self.A_lo
         c = (-d / self.ref).clamp(0.0, 1.0)
-        dy = offsets.new_zeros(offsets.shape[:-1])
-        dy = dy.index_add(-1, self.active, c * (self.gap - self.ref) * self.field)
-        return offsets + torch_stack_y(dy)
+        out = offsets.clone()
+        out[..., self.active, 1] += c * (self.gap - self.ref) * self.field
+        return out
 
 
-def torch_stack_y(dy):
-    """(..., N) -> (..., N, 3) with dy in y."""
-    import torch
-    z = torch.zeros_like(dy)
-    return torch.stack([z, dy, z], -1)
+class Closers:
+    """The retargeting of each face met (keyed by its neutral vertices), built once per face."""
+
+    def __init__(self, template: Template, reference_gap_mm: float):
+        self.template, self.reference = template, float(reference_gap_mm)
+        self._faces: dict[bytes, LipClosure] = {}
+
+    def __call__(self, face_mm: np.ndarray) -> LipClosure:
+        key = np.asarray(face_mm).tobytes()
+        if key not in self._faces:
+            self._faces[key] = LipClosure(self.template, face_mm, self.reference)
+        return self._faces[key]
 
 
 def reference_gap(ds, split: str = "train") -> tuple[float, int]:
@@ -120,20 +133,18 @@ def heard_bilabials(model, ds, split: str, progress=None) -> list[tuple[np.ndarr
     """Every /p b m/ segment of `split` the front-end heard (a P, B or M argmax at one of its content frames), as
     (face in mm, the model's offsets over the segment's frames): what fit() calibrates on."""
     import torch
-    from ..phones import BILABIALS, PHONES
+    from ..phones import BILABIALS
     from ..train import articulation as art
     from ..train.data import prepare
-    bil = [PHONES.index(p) for p in BILABIALS]
     rate = model.audio.feature_rate / model.cfg.content_stride
     out, keys = [], ds.keys(split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
         res = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
-        heard = res["logits"].argmax(-1).numpy()
+        calls = res["logits"].argmax(-1).numpy()
         offsets = res["offsets"].numpy()
         for p, a, b in c.segments:
-            k0 = int(a * rate)
-            if p in BILABIALS and np.isin(heard[k0 : max(k0 + 1, int(np.ceil(b * rate)))], bil).any():
+            if p in BILABIALS and art.called_bilabial(calls, art.content_span(a, b, rate)):
                 out.append((c.template, offsets[art.segment_frames(a, b, ds.fps, c.num_frames)]))
         if progress:
             progress(i + 1, len(keys))
@@ -143,27 +154,14 @@ def heard_bilabials(model, ds, split: str, progress=None) -> list[tuple[np.ndarr
 def fit(segments, template: Template, lo: float = 2.0, hi: float = 12.0) -> tuple[float, float]:
     """The reference gap at which the lips just meet on the median heard /p b m/ segment (median of each segment's
     smallest inner-lip gap = 0), by bisection (the gap grows with the reference). -> (reference mm, raw median mm)."""
-    faces = {}
     def median_gap(ref: float | None) -> float:
-        gaps = []
-        for face, o in segments:
-            if ref is not None:
-                k = (face.tobytes(), ref)
-                if k not in faces:
-                    faces[k] = LipClosure(template, face, ref)
-                o = faces[k].apply(o)
-            gaps.append(lip_gap(face[None] + o, template).min())
+        closers = Closers(template, ref) if ref is not None else None
+        gaps = [lip_gap(face[None] + (closers(face).apply(o) if closers else o), template).min() for face, o in segments]
         return float(np.median(gaps))
     for _ in range(14):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if median_gap(mid) > 0 else (mid, hi)
     return 0.5 * (lo + hi), median_gap(None)
-
-
-def from_checkpoint(ck: dict, template: Template, face_mm: np.ndarray) -> LipClosure | None:
-    """The retargeting a checkpoint carries (None: the model's offsets as they are)."""
-    lc = ck.get("lip_closure")
-    return LipClosure(template, face_mm, lc["reference_gap_mm"]) if lc else None
 
 
 def main(argv=None) -> int:

@@ -111,6 +111,17 @@ def content_counts(logits: np.ndarray, labels: np.ndarray, num_classes: int) -> 
     return conf
 
 
+def content_span(start: float, end: float, rate: float) -> slice:
+    """The content frames (at `rate` per second) of a segment [start, end): at least one."""
+    k0 = int(start * rate)
+    return slice(k0, max(k0 + 1, int(np.ceil(end * rate))))
+
+
+def called_bilabial(calls: np.ndarray, span: slice) -> bool:
+    """Whether the front-end's per-frame calls (argmax classes) name P, B or M at a frame of `span`."""
+    return bool(np.isin(calls[span], [PHONES.index(p) for p in BILABIALS]).any())
+
+
 def bilabial_heard(logits: np.ndarray, labels: np.ndarray) -> tuple[int, int]:
     """(segments of /p b m/ with a bilabial argmax at one or more of their frames, segments)."""
     bil = np.array([PHONES.index(p) for p in BILABIALS])

@@ -25,17 +25,18 @@ from .data import prepare
 from .train import load_checkpoint
 
 
-def segments(model, ds, split: str, lip_closure: dict | None = None) -> list[dict]:
-    """`lip_closure`: a checkpoint's retargeting of the closure to each face (model/lip_closure.py), or None."""
+def segments(model, ds, split: str, reference_gap: float | None = None) -> list[dict]:
+    """`reference_gap`: retarget the closure to each face with it (model/lip_closure.py), or None."""
     bil = [PHONES.index(p) for p in BILABIALS]
     rate = model.audio.feature_rate / model.cfg.content_stride
+    closers = lc.Closers(ds.template, reference_gap) if reference_gap is not None else None
     rows = []
     for key in ds.keys(split):
         c = prepare(ds, key, model.audio)
         out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
         offsets = out["offsets"].numpy()
-        if lip_closure:
-            offsets = lc.from_checkpoint({"lip_closure": lip_closure}, ds.template, c.template).apply(offsets)
+        if closers:
+            offsets = closers(c.template).apply(offsets)
         gap = art.inner_lip_gap(c.template[None] + offsets, ds.template)
         face_gap = float(art.inner_lip_gap(c.template[None], ds.template)[0])
         post = out["logits"].softmax(-1).numpy()
@@ -43,11 +44,10 @@ def segments(model, ds, split: str, lip_closure: dict | None = None) -> list[dic
             if p not in BILABIALS:
                 continue
             frames = art.segment_frames(a, b, ds.fps, len(gap))
-            k0 = int(a * rate)
-            k1 = max(k0 + 1, int(np.ceil(b * rate)))
+            span = art.content_span(a, b, rate)
             rows.append({"subject": ds.subject_of(key), "face_gap": face_gap,
-                         "heard": bool(np.isin(post[k0:k1].argmax(-1), bil).any()),
-                         "confidence": float(post[k0:k1][:, bil].sum(-1).max()) if k1 <= len(post) else 0.0,
+                         "heard": art.called_bilabial(post.argmax(-1), span),
+                         "confidence": float(post[span][:, bil].sum(-1).max()) if span.stop <= len(post) else 0.0,
                          "closed": bool(gap[frames].min() < art.CLOSED_MM), "min_gap": float(gap[frames].min())})
     return rows
 
@@ -86,8 +86,8 @@ def main(argv=None) -> int:
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
-    closure = None if args.raw else {"reference_gap_mm": args.reference_gap} if args.reference_gap else ck.get("lip_closure")
-    print("\n".join(report(segments(model, ds, args.split, closure))))
+    reference = None if args.raw else args.reference_gap or (ck.get("lip_closure") or {}).get("reference_gap_mm")
+    print("\n".join(report(segments(model, ds, args.split, reference))))
     return 0
 
 

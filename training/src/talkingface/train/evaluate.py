@@ -37,7 +37,7 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     (model/lip_closure.py); None: the model's offsets as they are."""
     model.eval()
     t = ds.template
-    closers: dict[bytes, lc.LipClosure] = {}
+    closers = lc.Closers(t, lip_closure) if lip_closure is not None else None
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
     per_clip, artic, heads = [], [], []
     D = model.cfg.content_classes
@@ -49,11 +49,8 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         mel = torch.from_numpy(c.mel)
         out = model.animate(mel, torch.from_numpy(c.template), c.num_frames)
         pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
-        if lip_closure is not None:
-            face = c.template.tobytes()
-            if face not in closers:
-                closers[face] = lc.LipClosure(t, c.template, lip_closure)
-            pred_unposed = c.template[None] + closers[face].apply(out["offsets"].numpy())
+        if closers:
+            pred_unposed = c.template[None] + closers(c.template).apply(out["offsets"].numpy())
             pred_posed = apply_pose_np(pred_unposed, pred_pose)
         if head is not None:
             feats, _ = hmodel.clip_features(model, c.mel, c.num_frames)

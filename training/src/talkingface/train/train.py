@@ -231,17 +231,11 @@ def main(argv=None) -> int:
                    path.with_suffix(".tmp"))
         os.replace(path.with_suffix(".tmp"), path)
 
-    closers: dict[bytes, lc.LipClosureTorch] = {}
+    closers = lc.Closers(ds.template, args.lip_closure) if args.lip_closure else None
 
     def retarget(out_: dict, faces: torch.Tensor) -> dict:
         """The model's offsets with the closure on each clip's own face (--lip-closure), posed again."""
-        o = []
-        for i, face in enumerate(faces):
-            key = face.numpy().tobytes()
-            if key not in closers:
-                closers[key] = lc.LipClosureTorch(lc.LipClosure(ds.template, face.numpy(), args.lip_closure))
-            o.append(closers[key].apply(out_["offsets"][i]))
-        o = torch.stack(o)
+        o = torch.stack([closers(face.numpy()).torch().apply(out_["offsets"][i]) for i, face in enumerate(faces)])
         unposed = faces[:, None] + o
         return {**out_, "offsets": o, "unposed": unposed, "vertices": apply_pose(unposed, out_["pose"])}
 
