@@ -70,7 +70,7 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
   }
   console.log(`${clip.name} through the fake microphone: /p b m/ closed ${hits}/${trials}, closed in other speech ${falseHits}/${others} (offset ${off.toFixed(3)} s)`);
   expect(trials).toBeGreaterThanOrEqual(4);
-  // The shipped model closes 75% of the test split's /p b m/ (88% in its recorded speech; docs/results/default.md),
+  // The shipped model closes 79% of the test split's /p b m/ (88% in its recorded speech; docs/results/default.md),
   // the previous one none; issue 14's target of 95% is not reached yet. Held here: at least 70% through the browser.
   expect(hits / trials, '/p b m/ segments with the lips closed').toBeGreaterThanOrEqual(0.7);
   expect(falseHits / others, 'other speech segments with the lips closed').toBeLessThan(0.25);
