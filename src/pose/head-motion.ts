@@ -1,13 +1,15 @@
 /**
  * The head's own motion (training/src/talkingface/model/head_motion.py, the same numbers): the pose head predicts
  * the mean of the many head movements a sentence can be said with, a head that barely moves; this adds a residual
- * rotation drawn from the distribution learned from the truth, conditioned on the pose token:
+ * rotation, the part the speech carries read from the pose token plus a draw from the distribution learned from
+ * the truth for the rest:
  *
- *   r_t = a1 r_{t-1} + a2 r_{t-2} + g softplus(W f_t + b) z_t     per axis, degrees (rotation vector components)
+ *   residual_t = A f_t + c + r_t                                  per axis, degrees (rotation vector components)
+ *   r_t = a1 r_{t-1} + a2 r_{t-2} + g softplus(W f_t + b) z_t
  *
  * z_t is a hash of (seed, frame, axis), so one seed gives the same motion offline, in chunks and streaming; the
- * state carried between chunks is the last two residuals. The residual turns the head about the neck pivot p:
- * R' = R_r R, t' = R_r (t - p) + p.
+ * state carried between chunks is the process's last two values. The residual turns the head about the neck
+ * pivot p: R' = R_r R, t' = R_r (t - p) + p.
  */
 import { f32, type Tensor } from '../model/safetensors';
 import type { ModelConstants } from '../model/manifest';
@@ -19,9 +21,11 @@ export interface HeadMotionParams {
   sigmaMean: Float32Array; // (3), gain included
   pivotMm: Float32Array;   // (3)
   gain: Float32Array;      // (3)
+  speechW: Float32Array;   // (3 x d) A: the part the speech carries
+  speechB: Float32Array;   // (3) c
 }
 
-/** What carries from chunk to chunk: the seed, the next frame and each axis's last two residuals. */
+/** What carries from chunk to chunk: the seed, the next frame and each axis's last two values of the process. */
 export interface HeadMotionState {
   seed: number;
   next: number;
@@ -39,6 +43,9 @@ export function headMotionParams(t: Map<string, Tensor>, m: ModelConstants): Hea
     sigmaMean: f32(t, 'head_motion.sigma_mean', [3]),
     pivotMm: f32(t, 'head_motion.pivot_mm', [3]),
     gain: f32(t, 'head_motion.gain', [3]),
+    // A model exported before the speech read-out has none: the process alone.
+    speechW: t.has('head_motion.speech_w') ? f32(t, 'head_motion.speech_w', [3, m.d_model]) : new Float32Array(3 * m.d_model),
+    speechB: t.has('head_motion.speech_b') ? f32(t, 'head_motion.speech_b', [3]) : new Float32Array(3),
   };
 }
 
@@ -86,7 +93,7 @@ export class HeadMotion {
    * process at the mean step size.
    */
   residuals(state: HeadMotionState, first: number, poseToken: Float32Array, count: number): Float64Array {
-    const { ar, sigmaW, sigmaB, sigmaMean, gain } = this.params;
+    const { ar, sigmaW, sigmaB, sigmaMean, gain, speechW, speechB } = this.params;
     const { d } = this;
     const seed = state.seed;
     const step = (t: number, k: number, s: number) => {
@@ -99,9 +106,12 @@ export class HeadMotion {
     const out = new Float64Array(count * 3);
     for (let i = 0; i < count; i++, state.next++) {
       for (let k = 0; k < 3; k++) {
-        let x = sigmaB[k];
-        for (let j = 0; j < d; j++) x += sigmaW[k * d + j] * poseToken[i * d + j];
-        out[3 * i + k] = step(state.next, k, gain[k] * softplus(x));
+        let x = sigmaB[k], speech = speechB[k];
+        for (let j = 0; j < d; j++) {
+          x += sigmaW[k * d + j] * poseToken[i * d + j];
+          speech += speechW[k * d + j] * poseToken[i * d + j];
+        }
+        out[3 * i + k] = speech + step(state.next, k, gain[k] * softplus(x));
       }
     }
     return out;

@@ -213,7 +213,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
         "tokens": {"count": "N + 1", "pose_token_index": template.num_vertices, "d_model": cfg.d_model, "heads": cfg.heads, "layers": cfg.layers,
                    "mask": "vertex j attends to itself and its 1-ring (template adjacency); the pose token attends to all; no vertex attends to the pose token"},
         "head_motion": ({"tensors": "head_motion.* in gava.safetensors", "default_seed": 0,
-                         "process": "r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
+                         "process": "residual_t = A f_t + c + r_t, r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; A, c: speech_w, speech_b; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
                         if head is not None else None),
         "lip_closure": ({"reference_gap_mm": float(closure["reference_gap_mm"]), "calibrated_on": closure.get("split"),
                          "rule": "at each x across the mouth, c = clamp(-(du - dl) / g_ref(x), 0, 1) of the model's offsets; the lips "
