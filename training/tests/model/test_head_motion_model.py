@@ -71,3 +71,18 @@ def test_the_gain_makes_the_typical_speaker_in_ratio_terms():
     pooled = hmod.fit(truth, feats, np.zeros(3), ridge=None)
     calm_pooled = [np.linalg.norm(pooled.sample(f, 900 + i).std(0)) for i, (f, s) in enumerate(zip(feats, speakers)) if s == "calm"]
     assert abs(np.mean(calm_pooled) / np.mean(calm_true) - 2.5) < 0.35
+
+
+def test_motion_stats_measures_spread_speed_and_jitter():
+    # A sine of amplitude 1 deg on one axis: spread 1/sqrt(2), speed the mean |derivative| per frame, jitter the
+    # mean |second difference|; scaling the track scales every measure.
+    t = np.arange(2000)
+    w = 2 * np.pi / 100
+    x = np.zeros((len(t), 3))
+    x[:, 0] = np.sin(w * t)
+    st = hmod.motion_stats([x])
+    assert abs(st["spread"] - 1 / np.sqrt(2)) < 1e-3
+    assert abs(st["speed"] - 2 / np.pi * w) < 1e-3
+    assert abs(st["jitter"] - 2 / np.pi * w * w) < 1e-4
+    st2 = hmod.motion_stats([3 * x])
+    assert all(abs(st2[k] - 3 * st[k]) < 1e-9 for k in st)
