@@ -8,6 +8,10 @@
  *
  *   gap' = g - c g        c = clamp(-(du - dl) / g_ref, 0, 1)        g_ref(x) = g(x) * reference / lipGap(face)
  *
+ * Before that, the mouth's amplitude: the model's offsets on the lips' tissue and the jaw are scaled by the
+ * manifest's mouth gain, fading to 1 with the rig's fields (a regression opens the mouth by about three quarters of
+ * the truth's motion).
+ *
  * Library code: no DOM. The fields are the avatar basis's (avatar/fields.ts), solved once per template.
  */
 import { faceFields } from '../avatar/fields';
@@ -35,11 +39,24 @@ export class LipClosure {
   private readonly gap: Float64Array;
   private readonly ref: Float64Array;
   private readonly field: Float64Array;
+  /** The vertices the mouth gain scales, and their factors. */
+  private readonly scaled: Int32Array;
+  private readonly factor: Float64Array;
   /** The neutral face's inner-lip gap (mm), as training measures it. */
   readonly faceGap: number;
 
-  constructor(template: FaceTemplate, readonly referenceGapMm: number) {
+  constructor(template: FaceTemplate, readonly referenceGapMm: number, readonly mouthGain = 1) {
     const f = faceFields(template);
+    const scaled: number[] = [], factor: number[] = [];
+    for (let i = 0; i < f.n && mouthGain !== 1; i++) {
+      const m = Math.min(1, Math.max(0, Math.max(f.wJaw[i], f.wLips[i])));
+      if (m > 0) {
+        scaled.push(i);
+        factor.push(1 + (mouthGain - 1) * m);
+      }
+    }
+    this.scaled = Int32Array.from(scaled);
+    this.factor = Float64Array.from(factor);
     const v = f.rest;
     const X = (i: number) => v[3 * i], Y = (i: number) => v[3 * i + 1];
     const ux = f.upperLip.map(X), lx = f.lowerLip.map(X);
@@ -72,11 +89,16 @@ export class LipClosure {
     return this.active.length;
   }
 
-  /** `offsets` (frames x N x 3, mm), the model's displacement: the lips closed by the face's own gap, in place. */
+  /** `offsets` (frames x N x 3, mm), the model's displacement: the mouth's amplitude scaled and the lips closed by
+   * the face's own gap, in place. */
   apply(offsets: Float32Array, frames: number, n: number): void {
     const m = this.active.length;
     const dy = new Float64Array(m);
     for (let fr = 0; fr < frames; fr++) {
+      for (let k = 0; k < this.scaled.length; k++) {
+        const o = fr * n * 3 + 3 * this.scaled[k];
+        for (let j = 0; j < 3; j++) offsets[o + j] *= this.factor[k];
+      }
       const base = fr * n * 3 + 1;
       const y = (v: number) => offsets[base + 3 * v];
       // Every vertex reads the model's offsets before any is moved (the contours are among the moved vertices).

@@ -87,7 +87,7 @@ export class Pipeline {
   /** The model's closure on the face's own lip gap (null: a model exported without it), built on first use. */
   get lipClosure(): LipClosure | null {
     const c = this.manifest.lip_closure;
-    if (this.closure === undefined) this.closure = c ? new LipClosure(this.template, c.reference_gap_mm) : null;
+    if (this.closure === undefined) this.closure = c ? new LipClosure(this.template, c.reference_gap_mm, c.mouth_gain ?? 1) : null;
     return this.closure;
   }
 

@@ -53,7 +53,8 @@ export interface Manifest {
   /** The head's own motion (tensors head_motion.* in the decoder weights), or null for a model exported without it. */
   head_motion?: { tensors: string; default_seed: number; process: string } | null;
   /** The model's closure retargeted to the face's own lip gap (engine/lip-closure.ts), or null for a model exported without it. */
-  lip_closure?: { reference_gap_mm: number; calibrated_on: string | null; rule: string } | null;
+  /** mouth_gain: the mouth's amplitude factor (absent in models exported before it: 1). */
+  lip_closure?: { reference_gap_mm: number; mouth_gain?: number; calibrated_on: string | null; rule: string } | null;
   /** The content encoder's classes in logit order (ARPAbet phones, SIL, <blank>). */
   content_phones: string[];
 }

@@ -5,6 +5,7 @@
 import { describe, expect, it } from 'vitest';
 import { f32 } from '../../../src/model/safetensors';
 import { LipClosure } from '../../../src/engine/lip-closure';
+import { faceFields } from '../../../src/avatar/fields';
 import { innerLipGaps } from '../../../src/template/lip-gap';
 import { MM_PER_UNIT, type FaceTemplate } from '../../../src/template/face-template';
 import { loadFixtures, loadManifest, loadTemplateFile, maxAbsDiff } from '../helpers/exported';
@@ -15,6 +16,7 @@ const template = await loadTemplateFile(manifest);
 const mm = MM_PER_UNIT[template.units];
 const n = template.vertexCount;
 const reference = manifest.lip_closure?.reference_gap_mm;
+const gain = manifest.lip_closure?.mouth_gain ?? 1;
 
 const withFace = (faceMm: Float32Array): FaceTemplate => ({ ...template, positions: Float32Array.from(faceMm, (v) => v / mm) });
 const gaps = (face: Float32Array, offsets: Float32Array, frames: number) => {
@@ -28,7 +30,7 @@ describe.runIf(reference !== undefined)('lip closure', () => {
     const count = input.length / (n * 3);
     for (const [face, want] of [['template_mm', 'lips_out'], ['template_wider_mm', 'lips_out_wider']] as const) {
       const offsets = input.slice();
-      new LipClosure(withFace(f32(fx, face)), reference!).apply(offsets, count, n);
+      new LipClosure(withFace(f32(fx, face)), reference!, gain).apply(offsets, count, n);
       expect(maxAbsDiff(offsets, f32(fx, want))).toBeLessThan(1e-4); // mm
     }
     expect(maxAbsDiff(input, f32(fx, 'lips_out_wider'))).toBeGreaterThan(0.5); // the fixture closes lips: it can fail
@@ -58,5 +60,22 @@ describe.runIf(reference !== undefined)('lip closure', () => {
       expect(after[1]).toBeCloseTo(before[1], 5);                           // an opening is the model's
     }
     expect(closer.vertexCount).toBeGreaterThan(template.regions.lips_inner_upper.length);
+  });
+
+  it('scales the mouth by its gain, fading with the rig\'s fields, and nothing else', () => {
+    const f = faceFields(template);
+    const opening = new Float32Array(n * 3);
+    for (let v = 0; v < n; v++) opening[3 * v + 1] = -2 * f.wJaw[v]; // the jaw drops 2 mm: no closure to make
+    const plain = opening.slice(), louder = opening.slice();
+    new LipClosure(template, reference!).apply(plain, 1, n);
+    new LipClosure(template, 1.3 * reference!, 1.3).apply(louder, 1, n);
+    let scaled = 0;
+    for (let v = 0; v < n; v++) {
+      const m = Math.min(1, Math.max(f.wJaw[v], f.wLips[v]));
+      expect(louder[3 * v + 1]).toBeCloseTo(plain[3 * v + 1] * (1 + 0.3 * m), 5);
+      if (m === 0) expect(louder[3 * v + 1]).toBe(plain[3 * v + 1]);
+      if (m > 0.99 && plain[3 * v + 1] !== 0) scaled++;
+    }
+    expect(scaled).toBeGreaterThan(20); // the chin and the lower lip at full gain: the test can fail
   });
 });

@@ -190,7 +190,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
 
     template_mm = (template.vertices * mm_per_unit).astype(np.float32)
     closure = ck.get("lip_closure")
-    closer = LipClosure(template, template_mm, closure["reference_gap_mm"]) if closure else None
+    closer = LipClosure(template, template_mm, closure["reference_gap_mm"], closure.get("mouth_gain", 1.0)) if closure else None
     fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head, closer)
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}
@@ -215,8 +215,10 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
         "head_motion": ({"tensors": "head_motion.* in gava.safetensors", "default_seed": 0,
                          "process": "residual_t = A f_t + c + r_t, r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; A, c: speech_w, speech_b; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
                         if head is not None else None),
-        "lip_closure": ({"reference_gap_mm": float(closure["reference_gap_mm"]), "calibrated_on": closure.get("split"),
-                         "rule": "at each x across the mouth, c = clamp(-(du - dl) / g_ref(x), 0, 1) of the model's offsets; the lips "
+        "lip_closure": ({"reference_gap_mm": float(closure["reference_gap_mm"]), "mouth_gain": float(closure.get("mouth_gain", 1.0)),
+                         "calibrated_on": closure.get("split"),
+                         "rule": "the model's offsets first scaled by 1 + (mouth_gain - 1) clamp(max(jaw field, lip fields), 0, 1); then "
+                                 "at each x across the mouth, c = clamp(-(du - dl) / g_ref(x), 0, 1) of those offsets; the lips "
                                  "close by c (g(x) - g_ref(x)) more, with the rig's lip fields; g the face's gap, g_ref = g * reference / lip gap "
                                  "(training/src/talkingface/model/lip_closure.py)"}
                         if closure else None),

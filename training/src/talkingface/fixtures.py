@@ -69,7 +69,7 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
         wider = template_mm.copy()
         wider[:, 1] -= 1.5 * lip_closure.lower_weight.astype(np.float32)
         tensors |= {"lips_in": lips_in, "lips_out": lip_closure.apply(lips_in), "template_wider_mm": wider,
-                    "lips_out_wider": LipClosure(lip_closure.template, wider, lip_closure.reference_gap).apply(lips_in)}
+                    "lips_out_wider": LipClosure(lip_closure.template, wider, lip_closure.reference_gap, lip_closure.mouth_gain).apply(lips_in)}
     for i, l in enumerate(layers):
         tensors[f"layer{i}"] = l
     tensors.update(attention)

@@ -61,3 +61,26 @@ def test_the_torch_version_is_the_same_and_passes_gradients(template):
     assert np.abs(out.detach().numpy() - o).max() > 0.1
     out[..., 1].sum().backward()
     assert torch.isfinite(t.grad).all() and t.grad.abs().sum() > 0
+
+
+def test_the_mouth_gain_scales_the_mouth_alone_and_a_full_closure_still_shuts(template):
+    import torch
+    from talkingface.model.lip_closure import LipClosureTorch
+    mm = template.to_millimetres()
+    face = template.vertices * mm
+    ref_gap = float(lip_gap(face[None], template)[0])
+    rig = Rig(template, face)
+    opening, closing = _offsets(rig, jaw=1.0), _offsets(rig, close=1.0)
+    plain, louder = LipClosure(template, face, ref_gap), LipClosure(template, face, 1.3 * ref_gap, mouth_gain=1.3)
+    out = louder.apply(opening)
+    mouth = np.clip(np.maximum(rig.w_jaw, rig.w_lips), 0, 1)
+    # An opening is the model's, 1.3 times on the lips and the jaw, as it was where neither field reaches.
+    lips = rig.w_lips > 0.99
+    assert np.allclose(out[:, lips], 1.3 * opening[:, lips], atol=1e-9)
+    assert np.allclose(out[:, mouth == 0], opening[:, mouth == 0])
+    assert lip_gap(face[None] + out, template)[0] > lip_gap(face[None] + plain.apply(opening), template)[0] + 0.5
+    # The reference calibrated for the gain (1.3 times the closing motion) shuts the lips as before.
+    assert abs(lip_gap(face[None] + louder.apply(closing), template)[0]) < 0.1
+    # The torch version scales the same.
+    o = np.concatenate([opening, closing]).astype(np.float32)
+    assert np.abs(LipClosureTorch(louder).apply(torch.from_numpy(o)).numpy() - louder.apply(o)).max() < 1e-4

@@ -51,8 +51,12 @@ def interpolation_matrix(x: np.ndarray, xs: np.ndarray) -> np.ndarray:
 class LipClosure:
     """The retargeting of one face (template topology, neutral vertices in mm) to a reference gap in mm."""
 
-    def __init__(self, template: Template, face_mm: np.ndarray, reference_gap_mm: float):
+    def __init__(self, template: Template, face_mm: np.ndarray, reference_gap_mm: float, mouth_gain: float = 1.0):
         rig = Rig(template, np.asarray(face_mm, np.float64))
+        # The mouth's amplitude: the model's offsets on the lips' tissue and the jaw scaled by mouth_gain, fading to
+        # 1 with the rig's fields (a regression opens the mouth by about three quarters of the truth's motion).
+        self.mouth_gain = float(mouth_gain)
+        self.gain = 1.0 + (self.mouth_gain - 1.0) * np.clip(np.maximum(rig.w_jaw, rig.w_lips), 0.0, 1.0)  # (N,)
         self.template = template
         self.lower_weight = rig.w_lower
         v = rig.rest
@@ -74,8 +78,9 @@ class LipClosure:
         return self._torch
 
     def apply(self, offsets: np.ndarray) -> np.ndarray:
-        """(F, N, 3) the model's offsets in mm -> the same with the lips closed by the face's own gap."""
-        o = np.array(offsets, dtype=np.float64, copy=True)
+        """(F, N, 3) the model's offsets in mm -> the same, the mouth's amplitude scaled, with the lips closed by the
+        face's own gap."""
+        o = np.array(offsets, dtype=np.float64, copy=True) * self.gain[:, None]
         a = self.active
         d = o[:, self.upper, 1] @ self.A_up[a].T - o[:, self.lower, 1] @ self.A_lo[a].T   # (F, |a|) du - dl
         c = np.clip(-d / self.ref[a], 0.0, 1.0)
@@ -94,13 +99,15 @@ class LipClosureTorch:
         self.upper, self.lower, self.active = (torch.as_tensor(i) for i in (lc.upper, lc.lower, a))
         self.A_up, self.A_lo = f32(lc.A_up[a].T), f32(lc.A_lo[a].T)            # (U, |a|), (L, |a|)
         self.gap, self.ref, self.field = f32(lc.gap[a]), f32(lc.ref[a]), f32(lc.field[a])
+        self.gain = f32(lc.gain)[:, None]                                       # (N, 1)
 
     def apply(self, offsets):
         """(..., N, 3) offsets in mm -> the same, retargeted (a new tensor; gradients flow through c)."""
-        y = offsets[..., 1]
+        scaled = offsets * self.gain
+        y = scaled[..., 1]
         d = y[..., self.upper] @ self.A_up - y[..., self.lower] @ self.A_lo
         c = (-d / self.ref).clamp(0.0, 1.0)
-        out = offsets.clone()
+        out = scaled.clone()
         out[..., self.active, 1] += c * (self.gap - self.ref) * self.field
         return out
 
@@ -108,14 +115,14 @@ class LipClosureTorch:
 class Closers:
     """The retargeting of each face met (keyed by its neutral vertices), built once per face."""
 
-    def __init__(self, template: Template, reference_gap_mm: float):
-        self.template, self.reference = template, float(reference_gap_mm)
+    def __init__(self, template: Template, reference_gap_mm: float, mouth_gain: float = 1.0):
+        self.template, self.reference, self.mouth_gain = template, float(reference_gap_mm), float(mouth_gain)
         self._faces: dict[bytes, LipClosure] = {}
 
     def __call__(self, face_mm: np.ndarray) -> LipClosure:
         key = np.asarray(face_mm).tobytes()
         if key not in self._faces:
-            self._faces[key] = LipClosure(self.template, face_mm, self.reference)
+            self._faces[key] = LipClosure(self.template, face_mm, self.reference, self.mouth_gain)
         return self._faces[key]
 
 
@@ -151,11 +158,12 @@ def heard_bilabials(model, ds, split: str, progress=None) -> list[tuple[np.ndarr
     return out
 
 
-def fit(segments, template: Template, lo: float = 2.0, hi: float = 12.0) -> tuple[float, float]:
+def fit(segments, template: Template, lo: float = 2.0, hi: float = 12.0, mouth_gain: float = 1.0) -> tuple[float, float]:
     """The reference gap at which the lips just meet on the median heard /p b m/ segment (median of each segment's
-    smallest inner-lip gap = 0), by bisection (the gap grows with the reference). -> (reference mm, raw median mm)."""
+    smallest inner-lip gap = 0) with the mouth's amplitude scaled by `mouth_gain`, by bisection (the gap grows with
+    the reference). -> (reference mm, raw median mm: the model's own offsets)."""
     def median_gap(ref: float | None) -> float:
-        closers = Closers(template, ref) if ref is not None else None
+        closers = Closers(template, ref, mouth_gain) if ref is not None else None
         gaps = [lip_gap(face[None] + (closers(face).apply(o) if closers else o), template).min() for face, o in segments]
         return float(np.median(gaps))
     for _ in range(14):
@@ -174,19 +182,25 @@ def main(argv=None) -> int:
     ap.add_argument("--checkpoint", type=Path, required=True, help="read, and written back with the reference gap")
     ap.add_argument("--out", type=Path, help="write here instead of back into --checkpoint")
     ap.add_argument("--split", default="val", help="the split to calibrate on (its voices unheard in training)")
+    ap.add_argument("--mouth-gain", type=float, help="scale the mouth's amplitude (the lips' tissue and the jaw) by this "
+                    "before closing (default: the checkpoint's, else 1; chosen on val: docs/results/README.md)")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
     segs = heard_bilabials(model, ds, args.split, lambda i, n: i % 20 == 0 and print(f"  {i}/{n} clips", file=sys.stderr))
-    ref, raw = fit(segs, ds.template)
+    gain = args.mouth_gain if args.mouth_gain is not None else float((ck.get("lip_closure") or {}).get("mouth_gain", 1.0))
+    if not 0.5 <= gain <= 2.0:
+        raise SystemExit(f"--mouth-gain {gain}: expected a factor between 0.5 and 2")
+    ref, raw = fit(segs, ds.template, mouth_gain=gain)
     train_mean, n = reference_gap(ds, "train")
-    ck["lip_closure"] = {"reference_gap_mm": ref, "split": args.split, "segments": len(segs),
+    ck["lip_closure"] = {"reference_gap_mm": ref, "mouth_gain": gain, "split": args.split, "segments": len(segs),
                          "raw_median_smallest_gap_mm": raw, "train_faces_mean_gap_mm": train_mean}
     torch.save(ck, args.out or args.checkpoint)
     print(f"{len(segs)} heard /p b m/ segments on {args.split}: median smallest gap {raw:.2f} mm as the model closes, 0 "
-          f"with a reference gap of {ref:.3f} mm (the {n} train faces' mean neutral gap: {train_mean:.3f} mm); "
+          f"with a reference gap of {ref:.3f} mm and the mouth's amplitude x{gain:g} (the {n} train faces' mean "
+          f"neutral gap: {train_mean:.3f} mm); "
           f"wrote {args.out or args.checkpoint}")
     return 0
 

@@ -30,14 +30,14 @@ from .train import load_checkpoint
 
 
 def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0,
-             lip_closure: float | None = None) -> dict:
+             lip_closure: float | None = None, mouth_gain: float = 1.0) -> dict:
     """The paper's metrics and the articulation and head-motion measures on `split`. `head`: the head's own motion
     (model/head_motion.py), drawn with `seed` and added to the predicted pose as the browser does; None: the mean pose.
     `lip_closure`: the reference gap (mm) that retargets the closure to each face as the browser does
-    (model/lip_closure.py); None: the model's offsets as they are."""
+    (model/lip_closure.py), with the mouth's amplitude scaled by `mouth_gain`; None: the model's offsets as they are."""
     model.eval()
     t = ds.template
-    closers = lc.Closers(t, lip_closure) if lip_closure is not None else None
+    closers = lc.Closers(t, lip_closure, mouth_gain) if lip_closure is not None else None
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
     per_clip, artic, heads = [], [], []
     D = model.cfg.content_classes
@@ -94,11 +94,11 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     head = {"all": hm.summarise(heads), "synthetic": hm.summarise([r for r in heads if r["source"] != "human"]),
             "human": hm.summarise([r for r in heads if r["source"] == "human"])}
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
-            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure),
+            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure, mouth_gain),
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
 
-def silence_probe(model, template, lip_closure: float | None = None) -> dict:
+def silence_probe(model, template, lip_closure: float | None = None, mouth_gain: float = 1.0) -> dict:
     """Two seconds of digital silence: how far apart does the model leave the inner lips (mm)?
     The corpus rig closes them in silence (about 0.4 mm, docs/corpus)."""
     mm = template.to_millimetres()
@@ -106,7 +106,7 @@ def silence_probe(model, template, lip_closure: float | None = None) -> dict:
     out = model.animate(torch.from_numpy(log_mel(np.zeros(2 * model.audio.sample_rate, np.float32), model.audio)), tpl, 2 * model.audio.fps)
     offsets = out["offsets"].numpy()
     if lip_closure is not None:
-        offsets = lc.LipClosure(template, tpl.numpy(), lip_closure).apply(offsets)
+        offsets = lc.LipClosure(template, tpl.numpy(), lip_closure, mouth_gain).apply(offsets)
     gap = lip_gap(tpl.numpy()[None] + offsets, template)
     neutral = lip_gap(tpl[None].numpy(), template)[0]
     return {"lip_gap_mean_mm": float(gap.mean()), "lip_gap_max_mm": float(gap.max()), "neutral_template_gap_mm": float(neutral)}
@@ -129,8 +129,9 @@ def main(argv=None) -> int:
     heads: list = []
     head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
     closure = ck["lip_closure"]["reference_gap_mm"] if "lip_closure" in ck and not args.raw_lips else None
-    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure)
-    res["lip_closure"] = {"reference_gap_mm": closure} if closure is not None else None
+    gain = float(ck["lip_closure"].get("mouth_gain", 1.0)) if closure is not None else 1.0
+    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain)
+    res["lip_closure"] = {"reference_gap_mm": closure, "mouth_gain": gain} if closure is not None else None
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
     res["head_motion"]["sampled"] = {"seed": args.head_seed} if head is not None else None
@@ -174,6 +175,7 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
         f"{' --raw-lips' if getattr(args, 'raw_lips', False) else ''}`.",
         "",
         (f"Lip closure retargeted to each face's own lip gap (reference gap {res['lip_closure']['reference_gap_mm']:.3f} mm, "
+         f"the mouth's amplitude x{res['lip_closure'].get('mouth_gain', 1.0):g}, "
          "`training/src/talkingface/model/lip_closure.py`), as the browser does." if res.get("lip_closure") else
          "The model's offsets as they are (no lip closure retargeting)."),
         "",
