@@ -15,6 +15,13 @@ def _offsets(rig: Rig, **params) -> np.ndarray:
     return rig.deform(p, np.zeros(1), np.zeros(1)) - rig.rest[None]
 
 
+def _reference(template):
+    """The template's own face (mm), its lip gap, its rig, and its full closure and jaw opening: a model trained on it."""
+    face = template.vertices * template.to_millimetres()
+    rig = Rig(template, face)
+    return face, float(lip_gap(face[None], template)[0]), rig, _offsets(rig, close=1.0), _offsets(rig, jaw=1.0)
+
+
 def test_interpolation_matrix_is_np_interp():
     xs = np.array([-2.0, -0.5, 0.0, 1.5])
     x = np.array([-3.0, -2.0, -1.0, 0.7, 1.5, 4.0])
@@ -24,11 +31,8 @@ def test_interpolation_matrix_is_np_interp():
 
 def test_a_full_closure_shuts_any_face_and_an_opening_is_the_models(template):
     mm = template.to_millimetres()
-    ref_face = template.vertices * mm
-    ref_gap = float(lip_gap(ref_face[None], template)[0])
     # The reference face's own closure and jaw opening stand in for a model trained on it.
-    ref_rig = Rig(template, ref_face)
-    closing, opening = _offsets(ref_rig, close=1.0), _offsets(ref_rig, jaw=1.0)
+    _, ref_gap, _, closing, opening = _reference(template)
     rng = np.random.default_rng(3)
     faces = [apply_identity(template, sample_subject(f"S{i}", rng).identity) * mm for i in range(6)]
     gaps = [float(lip_gap(f[None], template)[0]) for f in faces]
@@ -66,11 +70,7 @@ def test_the_torch_version_is_the_same_and_passes_gradients(template):
 def test_the_mouth_gain_scales_the_mouth_alone_and_a_full_closure_still_shuts(template):
     import torch
     from talkingface.model.lip_closure import LipClosureTorch
-    mm = template.to_millimetres()
-    face = template.vertices * mm
-    ref_gap = float(lip_gap(face[None], template)[0])
-    rig = Rig(template, face)
-    opening, closing = _offsets(rig, jaw=1.0), _offsets(rig, close=1.0)
+    face, ref_gap, rig, closing, opening = _reference(template)
     plain, louder = LipClosure(template, face, ref_gap), LipClosure(template, face, 1.3 * ref_gap, mouth_gain=1.3)
     out = louder.apply(opening)
     mouth = np.clip(np.maximum(rig.w_jaw, rig.w_lips), 0, 1)
