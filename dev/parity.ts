@@ -85,7 +85,8 @@ async function main() {
   // against PyTorch's vertices, in the template's units; in one chunk and in chunks of 5 frames.
   const audio = f32(fx, 'audio');
   const mmPerUnit = MM_PER_UNIT[template.units];
-  // With the head's own motion (seed 0, the engine's default) when the model has it: PyTorch drew the same residuals.
+  // With the head's own motion (seed 0, the engine's default) and the lip closure when the model has them: PyTorch
+  // drew the same residuals and closed the same lips.
   const torchVertices = Float32Array.from(f32(fx, fx.has('vertices_sampled') ? 'vertices_sampled' : 'vertices'), (v) => v / mmPerUnit);
   const engine = await TalkingFaceEngine.load({ backend: 'cpu', onnxProviders: ['wasm'] });
   const whole = await engine.animate(audio);

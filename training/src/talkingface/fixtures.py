@@ -58,8 +58,11 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
         from .model.head_motion import compose
         residual = head_motion.sample(pose_token.numpy(), seed=0)
         sampled = compose(pose.numpy(), residual, head_motion.pivot_mm)
+        # The whole engine's output: the sampled pose on the offsets as the engine gives them (the mouth's amplitude
+        # and the lip closure applied where the model has them).
+        engine_offsets = torch.from_numpy(lip_closure.apply(offsets.numpy())) if lip_closure is not None else offsets
         tensors |= {"head_residual": residual.astype(np.float32), "pose_sampled": sampled,
-                    "vertices_sampled": apply_pose(torch.from_numpy(template_mm)[None] + offsets, torch.from_numpy(sampled)).numpy()}
+                    "vertices_sampled": apply_pose(torch.from_numpy(template_mm)[None] + engine_offsets, torch.from_numpy(sampled)).numpy()}
     if lip_closure is not None:
         from .model.lip_closure import LipClosure
         # The clip's frames open the lips; silence closes them (c = 1) and 0.6 of it partly (c < 1): all three cases.
