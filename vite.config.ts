@@ -80,7 +80,7 @@ function modelsDir(): Plugin {
 
 /**
  * `vite build` builds the app (index.html) into dist/. `vite build --mode test` (npm run build:test, after it) adds
- * the test-only pages under dist/dev/ (parity, bench, live, long, environment): the tests and `npm run bench` use them; the
+ * the test-only pages under dist/dev/ (parity, bench, live, long, environment, ort-start): the tests and `npm run bench` use them; the
  * shipped app does not carry them.
  */
 export default defineConfig(({ mode }) => {
@@ -97,7 +97,8 @@ export default defineConfig(({ mode }) => {
       emptyOutDir: !testPages,
       rolldownOptions: {
         input: (testPages
-          ? { parity: page('dev/parity.html'), bench: page('dev/bench.html'), live: page('dev/live.html'), long: page('dev/long.html'), environment: page('dev/environment.html') }
+          ? { parity: page('dev/parity.html'), bench: page('dev/bench.html'), live: page('dev/live.html'), long: page('dev/long.html'), environment: page('dev/environment.html'),
+            ortStart: page('dev/ort-start.html') }
           : { main: page('index.html') }) as Record<string, string>,
       },
     },

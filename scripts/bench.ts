@@ -6,7 +6,7 @@
  *
  *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]     (BENCH_PORT=... to serve on another port than 4191)
  *   npm run bench -- --render-only                                (only the head's render benchmark, merged into the existing bench.json)
- *   npm run bench -- --first-load-only                            (the first load alone, printed; nothing written)
+ *   npm run bench -- --first-load-only                            (the first load alone, and onnxruntime alone, printed; nothing written)
  *   npm run bench -- --first-load-only --first-load-url URL       (... of a page served elsewhere, e.g. an older build)
  */
 import { chromium } from '@playwright/test';
@@ -21,7 +21,7 @@ import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
-import { measureFirstLoad, printFirstLoad, type FirstLoad } from './first-load';
+import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -91,6 +91,8 @@ async function main(): Promise<void> {
     }
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
     const firstLoad = await measureFirstLoad(browser, opt('--first-load-url', `http://127.0.0.1:${PORT}/`), 5);
+    // The floor under it: onnxruntime-web alone, started as the engine starts it (dev/ort-start.html).
+    await measureOnnxAlone(browser, `http://127.0.0.1:${PORT}/dev/ort-start.html`, firstLoad, 5);
     if (firstLoadOnly) {
       printFirstLoad(firstLoad);
       await browser.close();

@@ -26,6 +26,12 @@ export interface FirstLoad {
   ready_ms: number;
   /** Each load's ready_ms, in order. */
   ready_ms_each: number[];
+  /**
+   * The floor under ready_ms: the same time on dev/ort-start.html, which starts onnxruntime-web and the encoders'
+   * sessions as the engine does and nothing else (no face, no decoder); median, and each load.
+   */
+  onnxruntime_alone_ms?: number;
+  onnxruntime_alone_ms_each?: number[];
 }
 
 /** Records performance.now() when the page marks itself ready: works on any version of the demo page. */
@@ -40,7 +46,7 @@ const WATCH_READY = () => {
   }).observe(document, { subtree: true, attributes: true, attributeFilter: ['data-ready', 'data-engine'] });
 };
 
-async function oneLoad(browser: Browser, url: string): Promise<{ files: FetchedFile[]; face: number; engine: number }> {
+async function oneLoad(browser: Browser, url: string): Promise<{ files: FetchedFile[]; face: number | undefined; engine: number }> {
   const context = await browser.newContext();
   const page = await context.newPage();
   await page.addInitScript(WATCH_READY);
@@ -65,10 +71,10 @@ async function oneLoad(browser: Browser, url: string): Promise<{ files: FetchedF
   await page.goto(url);
   await page.waitForSelector('body[data-engine]', { timeout: 60_000 });
   const state = await page.evaluate(() => document.body.dataset.engine);
-  if (state !== 'ready') throw new Error(`the demo did not get ready (data-engine=${state})`);
+  if (state !== 'ready') throw new Error(`${url} did not get ready (data-engine=${state}${await page.evaluate(() => document.body.dataset.error ? `: ${document.body.dataset.error}` : '')})`);
   await page.waitForTimeout(500); // let late requests (the rest face's work, sample index) finish
   await Promise.all(pending);
-  const marks = await page.evaluate(() => (globalThis as unknown as { readyMarks: { face: number; engine: number } }).readyMarks);
+  const marks = await page.evaluate(() => (globalThis as unknown as { readyMarks: { face?: number; engine: number } }).readyMarks);
   await context.close();
   return { files: [...seen.values()].filter((f) => f.fetches > 0).sort((a, b) => b.bytes - a.bytes), face: marks.face, engine: marks.engine };
 }
@@ -86,15 +92,30 @@ export async function measureFirstLoad(browser: Browser, url: string, loads = 3)
     total_mib: total / 2 ** 20,
     files,
     fetched_twice: files.filter((f) => f.fetches > 1).map((f) => f.path),
-    face_shown_ms: median(runs.map((r) => r.face)),
+    face_shown_ms: median(runs.map((r) => r.face ?? NaN)),
     ready_ms: median(runs.map((r) => r.engine)),
     ready_ms_each: runs.map((r) => r.engine),
   };
 }
 
+/**
+ * Time to ready of dev/ort-start.html (`url`), `loads` fresh loads: onnxruntime-web started as the engine starts it,
+ * with nothing else on the page. Added to `r` (the demo's first load, measured in the same browser just before).
+ */
+export async function measureOnnxAlone(browser: Browser, url: string, r: FirstLoad, loads = 5): Promise<void> {
+  const each: number[] = [];
+  for (let i = 0; i < loads; i++) each.push((await oneLoad(browser, url)).engine);
+  r.onnxruntime_alone_ms = median(each);
+  r.onnxruntime_alone_ms_each = each;
+}
+
 export function printFirstLoad(r: FirstLoad): void {
   console.log(`\nfirst load: ${(r.total_bytes / 2 ** 20).toFixed(2)} MiB transferred in ${r.files.length} files; face shown ${r.face_shown_ms.toFixed(0)} ms, ` +
     `ready ${r.ready_ms.toFixed(0)} ms (median of ${r.ready_ms_each.length}: ${r.ready_ms_each.map((t) => t.toFixed(0)).join(', ')} ms)`);
+  if (r.onnxruntime_alone_ms !== undefined) {
+    console.log(`  onnxruntime alone (dev/ort-start.html: its worker, runtime and the encoders' sessions, nothing else on the page): ready ` +
+      `${r.onnxruntime_alone_ms.toFixed(0)} ms (median of ${r.onnxruntime_alone_ms_each!.length}: ${r.onnxruntime_alone_ms_each!.map((t) => t.toFixed(0)).join(', ')} ms)`);
+  }
   for (const f of r.files) console.log(`  ${(f.bytes / 1024).toFixed(1).padStart(9)} KiB  ${f.fetches > 1 ? `x${f.fetches}` : '  '}  ${f.encoding.padEnd(8)}  ${f.path}`);
   if (r.fetched_twice.length) console.log(`  fetched more than once: ${r.fetched_twice.join(', ')}`);
 }

@@ -1,0 +1,23 @@
+/**
+ * Test page (dev/ort-start.html, measured by npm run bench): onnxruntime-web alone, started as the engine starts it
+ * (its worker, the runtime's WebAssembly, the encoders' four sessions from the model's files) with nothing else on
+ * the page: no face to build or draw, no attention decoder. Its time to ready is the floor under the demo's
+ * (issue 18, docs/results/README.md). Marks body[data-engine] as the demo does. Not part of the app.
+ */
+import { fetchArtefacts } from '../src/model/artefacts';
+import { startOrt } from '../src/encoders/onnx-model';
+import { ContentEncoder } from '../src/encoders/content';
+import { PoseEncoder } from '../src/encoders/pose';
+
+async function main(): Promise<void> {
+  startOrt(['wasm']); // as TalkingFaceEngine.load does without a hardware GPU, before any file has arrived
+  const { manifest, files, template } = await fetchArtefacts();
+  void template.catch(() => undefined); // fetched as the engine fetches it, not needed here
+  await Promise.all([ContentEncoder.create(manifest, files, ['wasm']), PoseEncoder.create(manifest, files, ['wasm'])]);
+  document.body.dataset.engine = 'ready';
+}
+
+main().catch((e: Error) => {
+  document.body.dataset.error = e.message;
+  document.body.dataset.engine = 'error';
+});
