@@ -54,3 +54,19 @@ def test_content_confusion_and_bilabials_heard():
     assert s["frame_accuracy"] == 4 / 9
     assert s["bilabial_segments"] == 3 and s["bilabial_segments_heard"] == 1 / 3  # P heard once; M and B missed
     assert s["recall"]["M"]["recall"] == 0.0 and s["recall"]["M"]["mistaken_for"] == ["K"]
+
+
+def test_the_content_encoder_per_voice():
+    """espeak-ng's variants count with their accent; each voice's rows add its clips' frames and segments."""
+    assert art.voice_family("espeak:en-gb-scotland+m5") == art.voice_family("espeak:en-gb-scotland+klatt3") == "espeak:en-gb-scotland"
+    assert art.voice_family("festival:ked") == "festival:ked" and art.voice_family("") == "unknown"
+    D = len(PHONES) + 1
+    good, bad = np.zeros((D, D), np.int64), np.zeros((D, D), np.int64)
+    good[3, 3], good[4, 4] = 8, 2            # 10 frames, all right
+    bad[3, 3], bad[3, 5] = 1, 29             # 30 frames, 1 right
+    rows = art.voice_rows({"festival:ked": [2, good, 3, 4], "flite:awb": [1, bad, 0, 2]})
+    assert [r["voice"] for r in rows] == ["flite:awb", "festival:ked"]  # the most frames first
+    assert rows[0]["frames"] == 30 and abs(rows[0]["frame_accuracy"] - 1 / 30) < 1e-12 and rows[1]["frame_accuracy"] == 1.0
+    assert rows[1]["clips"] == 2 and (rows[1]["bilabial_segments_heard"], rows[1]["bilabial_segments"]) == (3, 4)
+    md = "\n".join(art.voice_markdown(rows))
+    assert "| flite:awb | 1 | 30 | 3.3% | 0 of 2 |" in md

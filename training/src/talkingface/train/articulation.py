@@ -157,6 +157,19 @@ def content_summary(conf: np.ndarray, heard: tuple[int, int]) -> dict:
             "recall": recall, "confusion": conf.tolist()}
 
 
+def voice_family(voice: str) -> str:
+    """The voice a clip's `voice` names, espeak-ng's variants ("+m5", "+klatt3") folded into their accent: each has
+    only a clip or two, and what the front-end meets in them is the accent."""
+    return voice.split("+")[0] if voice.startswith("espeak:") else (voice or "unknown")
+
+
+def voice_rows(by_voice: dict) -> list[dict]:
+    """{voice: [clips, (D, D) confusion, heard, segments]} -> rows of the per-voice table, the most frames first."""
+    rows = [{"voice": v, "clips": n, "frames": int(conf.sum()), "frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
+             "bilabial_segments_heard": h, "bilabial_segments": segs} for v, (n, conf, h, segs) in by_voice.items()]
+    return sorted(rows, key=lambda r: -r["frames"])
+
+
 def markdown(res: dict) -> list[str]:
     """The articulation and content-encoder tables of docs/results/<model>.md."""
     pct = lambda x: f"{100 * x:.1f}%"
@@ -197,5 +210,23 @@ def markdown(res: dict) -> list[str]:
         "| clips | frame accuracy | speech frames | /p b m/ segments heard | recall P / B / M / F / V |",
         "| --- | --- | --- | --- | --- |",
         *crow,
+        "",
+        *voice_markdown(res["content_encoder"].get("by_voice")),
+    ]
+
+
+def voice_markdown(rows: list[dict] | None) -> list[str]:
+    """The content encoder per voice (voice_rows): which of the split's voices it hears, and which it does not."""
+    if not rows:
+        return []
+    pct = lambda x: f"{100 * x:.1f}%"
+    return [
+        "By voice (espeak-ng's variants counted with their accent: each has a clip or two; on the test split, the voices",
+        "training never hears are festival's ked, flite's awb, espeak-ng's Scottish accent and its klatt3 and f5 variants):",
+        "",
+        "| voice | clips | frames | frame accuracy | /p b m/ segments heard |",
+        "| --- | --- | --- | --- | --- |",
+        *[f"| {r['voice']} | {r['clips']} | {r['frames']} | {pct(r['frame_accuracy'])} | {r['bilabial_segments_heard']} of {r['bilabial_segments']} |"
+          for r in rows],
         "",
     ]

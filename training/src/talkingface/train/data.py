@@ -45,6 +45,7 @@ class PreparedClip:
     source: str                 # "tts" or "human" (recorded speech)
     rest: np.ndarray | None = None  # (N, 3) the subject's rest face, mm (set by attach_rest_faces)
     segments: list | None = None    # [(phone, start s, end s)] as aligned, for the articulation measures
+    voice: str = ""                 # who speaks: "festival:ked", "espeak:en-gb-scotland+m5", "human:allison" ("" if unknown)
 
     @property
     def num_frames(self) -> int:
@@ -63,7 +64,7 @@ def prepare(ds: FaceDataset, key: str, audio: AudioConfig = AudioConfig()) -> Pr
     pose = pose.copy()
     pose[:, 3:] *= mm
     return PreparedClip(key, mel, phones, clip.vertices * mm, clip.template * mm, pose.astype(np.float32),
-                        clip.meta.get("source", "real"), segments=list(clip.phones or []))
+                        clip.meta.get("source", "real"), segments=list(clip.phones or []), voice=str(clip.meta.get("voice", "")))
 
 
 @dataclass
