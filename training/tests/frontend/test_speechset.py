@@ -57,3 +57,26 @@ def test_an_accented_voice_reads_its_own_style_table(monkeypatch, tmp_path):
         assert kokoro.accented_voice_names() == ["accented/ff_c"]
     finally:
         kokoro._style_table.cache_clear()
+
+
+def test_the_vocoder_keeps_the_words_and_replaces_the_source():
+    """A vowel at 140 Hz with a formant near 700 Hz, vocoded: the same length, the envelope kept (the formant still
+    stands out), and pitched at its own F0 by the vocoder's pulses; noise stays unvoiced noise."""
+    import numpy as np
+    from talkingface.corpus.augment import vocode
+    sr, f0 = 16000, 140.0
+    t = np.arange(int(1.0 * sr)) / sr
+    vowel = sum(np.exp(-(((k * f0) - 700) / 300) ** 2) * np.sin(2 * np.pi * k * f0 * t) for k in range(1, 40)).astype(np.float32)
+    y = vocode(0.5 * vowel / np.abs(vowel).max(), sr, np.random.default_rng(0), noise_mix=0.0)
+    assert y.shape == vowel.shape and np.isfinite(y).all() and 0.1 < np.abs(y).max() <= 0.5 + 1e-6
+    mid = y[4000:12000].astype(np.float64)
+    spec = np.abs(np.fft.rfft(mid * np.hanning(len(mid))))
+    freqs = np.fft.rfftfreq(len(mid), 1 / sr)
+    assert spec[(freqs > 500) & (freqs < 900)].mean() > 5 * spec[(freqs > 2500) & (freqs < 4000)].mean()  # the formant
+    ac = np.correlate(mid, mid, "full")[len(mid) - 1:]
+    lag = np.argmax(ac[int(sr / 300):int(sr / 80)]) + int(sr / 300)
+    assert abs(sr / lag - f0) < 5  # periodic at the speech's own pitch
+    noise = np.random.default_rng(1).standard_normal(sr).astype(np.float32) * 0.1
+    z = vocode(noise, sr, np.random.default_rng(2))
+    zc = np.correlate(z[4000:12000], z[4000:12000], "full")[7999:]
+    assert zc[int(sr / 300):int(sr / 80)].max() < 0.3 * zc[0]  # no pitch where there was none

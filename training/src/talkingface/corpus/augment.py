@@ -6,6 +6,8 @@ at a random SNR, reverberation (a synthetic exponentially decaying room
 response), band-limiting (telephone 300-3400 Hz at 8 kHz, or a random low-pass)
 and microphone colouring (a smooth random EQ curve). Each is drawn per clip
 from the clip's own seeded generator, and the draw is recorded with the clip.
+`vocode` (the speech front-end's set only, frontend/speechset.py --vocode) says speech again through
+a simple vocoder, as diphone and parametric synthesisers do.
 """
 from __future__ import annotations
 
@@ -164,3 +166,49 @@ def augment_channel(audio: np.ndarray, sr: int, rng: np.random.Generator, streng
         x = x * 10 ** (gain_db / 20)
         desc["gain_db"] = round(gain_db, 1)
     return x.astype(np.float32), desc
+
+
+# ---- a synthesiser's vocoder -----------------------------------------------------------------------------
+
+VOCODE_FRAME, VOCODE_HOP = 512, 128      # at 16 kHz: 32 ms frames every 8 ms
+VOCODE_CEPSTRA = 30                      # cepstral coefficients kept for the envelope (the vocal tract, not the pitch)
+
+
+def vocode(audio: np.ndarray, sr: int, rng: np.random.Generator, noise_mix: float | None = None) -> np.ndarray:
+    """Speech as a vocoder-based synthesiser would say it: each frame's spectral envelope (cepstrally smoothed) excited
+    by a pulse train at the speech's own pitch where it is voiced and by noise where it is not, then overlap-added.
+    The words, their timing and the vocal tract stay; the voice's own source goes, buzzy as in diphone (LPC) and
+    statistical-parametric (mel-cepstral) voices. `noise_mix`: share of noise in voiced frames (default: drawn, 0-0.3)."""
+    from .prosody import frame_pitch
+    x = audio.astype(np.float64)
+    n, N, H = len(x), VOCODE_FRAME, VOCODE_HOP
+    if n < N:
+        return audio.astype(np.float32)
+    frames = 1 + (n - N) // H
+    win = np.hanning(N + 1)[:-1]
+    idx = np.arange(N)[None, :] + H * np.arange(frames)[:, None]
+    spec = np.fft.rfft(x[idx] * win, axis=1)                                      # (frames, N/2+1)
+    ceps = np.fft.irfft(np.log(np.abs(spec) + 1e-8), N, axis=1)
+    ceps[:, VOCODE_CEPSTRA:N - VOCODE_CEPSTRA + 1] = 0.0                          # lifter: keep the envelope
+    envelope = np.exp(np.fft.rfft(ceps, axis=1).real)
+    # Excitation: pulses at the frame's pitch (phase carried from sample to sample), noise where unvoiced.
+    f0 = frame_pitch(audio, sr, frames, sr / H)                                    # frame i at sample i * H
+    t = np.arange(n) / H
+    f0s = np.interp(t, np.arange(frames), f0)
+    voiced = np.interp(t, np.arange(frames), (f0 > 0).astype(np.float64)) > 0.5
+    phase = np.cumsum(np.where(voiced, f0s, 0.0) / sr)
+    pulses = np.zeros(n)
+    pulses[1:][np.diff(np.floor(phase)) > 0] = 1.0
+    mix = float(rng.uniform(0.0, 0.3)) if noise_mix is None else noise_mix
+    noise = rng.standard_normal(n)
+    pulses *= np.sqrt(sr / np.maximum(f0s, 50.0))                                  # unit power at any pitch
+    excitation = np.where(voiced, np.sqrt(1 - mix) * pulses + np.sqrt(mix) * noise, noise)
+    exc = np.fft.rfft(excitation[idx] * win, axis=1)
+    exc /= np.sqrt(np.mean(np.abs(exc) ** 2, axis=1, keepdims=True)) + 1e-12    # flat on average: the envelope sets the level
+    y_frames = np.fft.irfft(exc * envelope, N, axis=1) * win
+    y, norm = np.zeros(n), np.zeros(n)
+    np.add.at(y, idx, y_frames)
+    np.add.at(norm, idx, np.broadcast_to(win ** 2, y_frames.shape))
+    y /= np.maximum(norm, 1e-3)
+    peak = np.max(np.abs(y)) + 1e-9
+    return (y / peak * min(1.0, float(np.max(np.abs(x))) or 1.0)).astype(np.float32)

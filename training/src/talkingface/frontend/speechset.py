@@ -11,7 +11,8 @@ front-end trains apart from the face, on this set:
 
 Phone labels: the synthesiser's own timings (festival, flite) or pocketsphinx forced alignment (the rest).
 Each clip gets the corpus's augmentation (tempo, pitch, microphone, room, noise, band, level) with
-probability AUGMENT_SHARE. The face corpus's test voices, test sentences and test recordings never occur here,
+probability AUGMENT_SHARE; with `--vocode SHARE`, that share of the clips is first said through a vocoder
+(corpus/augment.py, vocode: the voice's own source replaced by pulses at its pitch), as older synthesisers sound. The face corpus's test voices, test sentences and test recordings never occur here,
 so its test split measures the front-end on held-out voices.
 
 Output: one .npz per clip (log-Mel as float16, a phone class per Mel frame) and an index.jsonl.
@@ -33,7 +34,7 @@ import numpy as np
 
 from ..corpus import kokoro, recorded
 from ..corpus.align import AlignmentError, Aligner
-from ..corpus.augment import augment_channel, augment_speech
+from ..corpus.augment import augment_channel, augment_speech, vocode
 from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
 from ..corpus.sentences import generate_sentences
 from ..corpus.speech import Voice, all_voices, fit_to_duration, synthesize
@@ -139,13 +140,18 @@ def frame_labels(phones, n_frames: int, feature_rate: float) -> np.ndarray:
 
 
 def build_one(args) -> dict:
-    spec, out = args
+    spec, out, vocode_share = args
     audio_cfg = AudioConfig()
     rng = np.random.default_rng(spec.seed)
     try:
         audio, phones = speak(spec, audio_cfg.sample_rate)
     except (AlignmentError, RuntimeError) as e:  # recorded as skipped with its reason; the set goes on
         return asdict(spec) | {"skipped": f"{type(e).__name__}: {e}"}
+    # Vocoding draws from a generator of its own: with --vocode 0 a set is the one built before the option existed.
+    vrng = np.random.default_rng([spec.seed, 1])
+    vocoded = bool(vrng.random() < vocode_share)
+    if vocoded:
+        audio = vocode(audio, audio_cfg.sample_rate, vrng)
     strength = 1.0 if rng.random() < AUGMENT_SHARE else 0.0
     audio, phones, a1 = augment_speech(audio, audio_cfg.sample_rate, phones, rng, strength)
     phones = fit_to_duration(phones, len(audio) / audio_cfg.sample_rate)
@@ -153,11 +159,13 @@ def build_one(args) -> dict:
     mel = log_mel(audio, audio_cfg)
     labels = frame_labels(phones, len(mel), audio_cfg.feature_rate)
     np.savez(Path(out) / f"{spec.key}.npz", mel=mel.astype(np.float16), labels=labels)
-    return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2}
+    return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2 | ({"vocoded": True} if vocoded else {})}
 
 
-def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None) -> dict:
-    """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly)."""
+def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
+          vocode_share: float = 0.0) -> dict:
+    """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
+    clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound."""
     out.mkdir(parents=True, exist_ok=True)
     specs = plan(minutes, seed, kokoro_voices)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
@@ -165,7 +173,7 @@ def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str
     t0, n = time.time(), 0
     print(f"speech set: {len(specs)} clips planned, {len(todo)} to build, {workers} workers -> {out}", file=sys.stderr)
     with get_context("fork").Pool(workers) as pool, open(out / "index.jsonl", "a") as index:
-        for rec in pool.imap_unordered(build_one, [(s, str(out)) for s in todo], chunksize=2):
+        for rec in pool.imap_unordered(build_one, [(s, str(out), vocode_share) for s in todo], chunksize=2):
             index.write(json.dumps(rec) + "\n")
             index.flush()
             n += 1
@@ -175,7 +183,7 @@ def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str
     rows = [json.loads(l) for l in (out / "index.jsonl").read_text().splitlines()]
     ok = [r for r in rows if "skipped" not in r]
     meta = {"clips": len(ok), "skipped": len(rows) - len(ok), "minutes": round(sum(r["seconds"] for r in ok) / 60, 1),
-            "seed": seed, "voices": len({r["voice"] for r in ok}),
+            "seed": seed, "voices": len({r["voice"] for r in ok}), "vocoded": sum(bool(r["augment"].get("vocoded")) for r in ok),
             "by_engine": {e: sum(r["engine"] == e for r in ok) for e in sorted({r["engine"] for r in ok})}}
     (out / "meta.json").write_text(json.dumps(meta, indent=1))
     return meta
@@ -191,8 +199,13 @@ def main(argv=None) -> int:
     ap.add_argument("--kokoro-voices", choices=KOKORO_VOICES, default="english",
                     help="Kokoro's English voices, its accented ones (setup --kokoro-accented), or all of them")
     ap.add_argument("--first", type=int, help="build only the plan's first N clips (the plan itself is that of --minutes)")
+    ap.add_argument("--vocode", type=float, default=0.0, metavar="SHARE",
+                    help="say this share of the clips through a vocoder first: buzzy, as diphone and parametric voices "
+                         "(festival's, flite's) sound (default 0)")
     args = ap.parse_args(argv)
-    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first)
+    if not 0.0 <= args.vocode <= 1.0:
+        ap.error(f"--vocode is a share of the clips, from 0 to 1 (got {args.vocode})")
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
