@@ -1,0 +1,93 @@
+"""Measure speech front-ends by themselves, side by side: frame accuracy, /p b m/ heard, and both per voice.
+
+  scripts/py -m talkingface.frontend.measure --corpus data/corpus [--split val,test] FRONTEND [FRONTEND ...] [--out F.json]
+
+Each FRONTEND is a front-end file (frontend.train's frontend.pt) or a face checkpoint, whose content encoder is read
+(models/checkpoint.pt: the shipped one). The numbers are those of `talkingface.train.evaluate`'s content encoder
+tables (docs/results/default.md) without training or running a face: a few seconds per split, so a new front-end
+can be compared with the shipped one on the held-out voices before a face is trained on it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..data.datasets import open_dataset
+from ..features import AudioConfig
+from ..model.config import ModelConfig
+from ..model.encoders import ContentEncoder
+from ..train import articulation as art
+from ..train.data import prepare
+from ..train.train import load_frontend
+
+
+def load_encoder(path: str) -> tuple[ContentEncoder, ModelConfig]:
+    """The content encoder of a front-end file or a face checkpoint, its Mel normalisation included."""
+    ck = load_frontend(path)
+    cfg = ModelConfig.from_dict(ck["model_config"])
+    enc = ContentEncoder(cfg, AudioConfig().n_mels)
+    enc.load_state_dict(ck["content"])
+    return enc.eval(), cfg
+
+
+@torch.no_grad()
+def measure(enc: ContentEncoder, cfg: ModelConfig, clips) -> dict:
+    """Over prepared clips: content_summary's figures for all of them, and voice_rows per voice."""
+    D = cfg.content_classes
+    conf, heard, by_voice = np.zeros((D, D), np.int64), [0, 0], {}
+    for c in clips:
+        logits = enc(torch.from_numpy(c.mel)[None])[0].numpy()
+        labels = c.phones[:: cfg.content_stride]
+        counts, (h, n) = art.content_counts(logits, labels, D), art.bilabial_heard(logits, labels)
+        conf += counts
+        heard[0] += h
+        heard[1] += n
+        v = by_voice.setdefault(art.voice_family(c.voice), [0, np.zeros((D, D), np.int64), 0, 0])
+        v[0], v[1], v[2], v[3] = v[0] + 1, v[1] + counts, v[2] + h, v[3] + n
+    s = art.content_summary(conf, tuple(heard))
+    return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
+            "bilabial_segments": s["bilabial_segments"], "by_voice": art.voice_rows(by_voice)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.measure", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("frontends", nargs="+", help="front-end files (frontend.pt) or face checkpoints")
+    ap.add_argument("--corpus", type=Path, required=True)
+    ap.add_argument("--split", default="val,test", help="the corpus's splits to measure on, comma-separated (default: val,test)")
+    ap.add_argument("--out", type=Path, help="also write the figures here (JSON)")
+    args = ap.parse_args(argv)
+    args.split = [s for s in args.split.split(",") if s]
+    ds = open_dataset(args.corpus)
+    audio = AudioConfig()
+    clips = {s: [prepare(ds, k, audio) for k in ds.keys(s)] for s in args.split}
+    results = {}
+    for path in args.frontends:
+        enc, cfg = load_encoder(path)
+        results[path] = {s: measure(enc, cfg, clips[s]) for s in args.split}
+    pct = lambda x: f"{100 * x:.1f}%"
+    for s in args.split:
+        print(f"\n{s} split ({len(clips[s])} clips): frame accuracy, /p b m/ segments heard")
+        for path, r in results.items():
+            print(f"  {pct(r[s]['frame_accuracy']):>6}  {pct(r[s]['bilabial_segments_heard']):>6} of {r[s]['bilabial_segments']}  {path}")
+        voices = [row["voice"] for row in results[args.frontends[0]][s]["by_voice"]]
+        print(f"  per voice (frame accuracy; one column per front-end, in the order above):")
+        for v in voices:
+            cells = []
+            for r in results.values():
+                row = next(x for x in r[s]["by_voice"] if x["voice"] == v)
+                cells.append(f"{pct(row['frame_accuracy']):>6} ({row['bilabial_segments_heard']}/{row['bilabial_segments']})")
+            print(f"    {v:28s} {row['frames']:6d} frames  " + "  ".join(cells))
+    if args.out:
+        args.out.write_text(json.dumps(results, indent=1))
+        print(f"\nwritten: {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
