@@ -1,6 +1,6 @@
 """Command line for the synthetic corpus.
 
-  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]]   install the Debian speech tools (apt) [and Kokoro's voices]
+  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]] [--foreign-voices]   install the Debian speech tools (apt) [and Kokoro's voices]
   scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
   scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
   scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
@@ -46,7 +46,9 @@ def cmd_setup(args) -> int:
         from . import kokoro
         print(f"kokoro: {kokoro.setup(accented=args.kokoro_accented)}: {len(kokoro.voice_names())} English voices, "
               f"{len(kokoro.accented_voice_names())} accented")
-    missing = [p for p in DEBIAN_PACKAGES if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
+    from .foreign import FOREIGN_PACKAGES
+    wanted = DEBIAN_PACKAGES + (FOREIGN_PACKAGES if args.foreign_voices else ())
+    missing = [p for p in wanted if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
     if not missing:
         print("speech tools: all installed")
         return 0
@@ -98,6 +100,8 @@ def main(argv=None) -> int:
     st.add_argument("--kokoro", action="store_true", help="also fetch the Kokoro voices (hash-pinned) for the speech front-end")
     st.add_argument("--kokoro-accented", action="store_true",
                     help="and Kokoro's 26 other-language voices, which speak English with an accent (corpus/kokoro.py)")
+    st.add_argument("--foreign-voices", action="store_true",
+                    help="and festival's Italian, Czech and Finnish voices, which speak English through a phone map (corpus/foreign.py)")
     st.set_defaults(fn=cmd_setup)
     b = sub.add_parser("build", help="build a corpus")
     b.add_argument("--preset", choices=sorted(PRESETS), default="small")

@@ -6,7 +6,9 @@ front-end trains apart from the face, on this set:
 
 - Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds; with
   `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices);
-- festival, flite and espeak-ng voices (corpus/speech.py);
+- festival, flite and espeak-ng voices (corpus/speech.py); with `--foreign SHARE`, that share of the clips said by
+  festival's Italian, Czech and Finnish diphone voices through a phone map (corpus/foreign.py): more voices of the
+  older synthesisers' kind, which the front-end hears worst;
 - the recorded human speech of the corpus's train split (one speaker, real microphones).
 
 Phone labels: the synthesiser's own timings (festival, flite) or pocketsphinx forced alignment (the rest).
@@ -32,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..corpus import kokoro, recorded
+from ..corpus import foreign, kokoro, recorded
 from ..corpus.align import AlignmentError, Aligner
 from ..corpus.augment import augment_channel, augment_speech, vocode
 from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
@@ -49,7 +51,7 @@ SHARES = {"kokoro": 0.6, "classic": 0.25, "human": 0.15}  # of the clips; the hu
 @dataclass
 class SpeechSpec:
     key: str
-    engine: str          # "kokoro", "festival", "flite", "espeak" or "human"
+    engine: str          # "kokoro", "festival", "flite", "espeak", "foreign" or "human"
     voice: str           # voice name, a Kokoro blend "a*0.7+b", or the recording's name
     text: str
     speed: float
@@ -75,8 +77,10 @@ def texts(n: int, seed: int) -> list[str]:
 KOKORO_VOICES = ("english", "accented", "all")
 
 
-def plan(minutes: float, seed: int, kokoro_voices: str = "english") -> list[SpeechSpec]:
-    """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54."""
+def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0) -> list[SpeechSpec]:
+    """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54.
+    `foreign_share`: the share of clips given instead to festival's foreign voices (corpus/foreign.py), drawn from a
+    generator of their own, so with 0 the plan is the one made before the option existed."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
@@ -86,6 +90,10 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english") -> list[Spee
         flag = "--kokoro" if kokoro_voices == "english" else "--kokoro --kokoro-accented"
         raise kokoro.KokoroMissing(f"Kokoro's {kokoro_voices} voices are not set up: run `scripts/py -m talkingface.corpus setup {flag}`")
     classic = [v for v in all_voices() if not is_test_voice(v)]
+    others = foreign.available() if foreign_share > 0 else []
+    if foreign_share > 0 and not others:
+        raise foreign.SpeechToolError("festival's foreign voices are not installed: run `scripts/py -m talkingface.corpus setup --foreign-voices`")
+    frng = np.random.default_rng([seed, 2])
     humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
     for i in range(n):
@@ -105,6 +113,8 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english") -> list[Spee
                 b = k_voices[rng.integers(len(k_voices))]
                 a = f"{a}*{rng.uniform(0.3, 0.7):.2f}+{b}" if b != a else a
             specs.append(SpeechSpec(key, "kokoro", a, text, float(rng.uniform(0.85, 1.2)), clip_seed))
+        if others and frng.random() < foreign_share:
+            specs[-1] = SpeechSpec(key, "foreign", others[frng.integers(len(others))], text, float(frng.uniform(0.85, 1.15)), clip_seed)
     return specs
 
 
@@ -121,6 +131,8 @@ def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
         audio, rate = read_wav(rec.path)
         audio = resample(audio, rate, sr)
         phones = None
+    elif spec.engine == "foreign":
+        audio, phones = foreign.synthesize_foreign(spec.voice, spec.text, sr, spec.speed, spec.seed)
     elif spec.engine == "kokoro":
         audio = resample(kokoro.synthesize(spec.voice, spec.text, spec.speed), kokoro.KOKORO_RATE, sr)
         audio = np.concatenate([np.zeros(int(0.2 * sr), np.float32), audio, np.zeros(int(0.2 * sr), np.float32)])
@@ -163,11 +175,11 @@ def build_one(args) -> dict:
 
 
 def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
-          vocode_share: float = 0.0) -> dict:
+          vocode_share: float = 0.0, foreign_share: float = 0.0) -> dict:
     """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
     clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound."""
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed, kokoro_voices)[:first]
+    specs = plan(minutes, seed, kokoro_voices, foreign_share)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -202,10 +214,14 @@ def main(argv=None) -> int:
     ap.add_argument("--vocode", type=float, default=0.0, metavar="SHARE",
                     help="say this share of the clips through a vocoder first: buzzy, as diphone and parametric voices "
                          "(festival's, flite's) sound (default 0)")
+    ap.add_argument("--foreign", type=float, default=0.0, metavar="SHARE",
+                    help="give this share of the clips to festival's Italian, Czech and Finnish voices speaking English "
+                         "(setup --foreign-voices; corpus/foreign.py) (default 0)")
     args = ap.parse_args(argv)
-    if not 0.0 <= args.vocode <= 1.0:
-        ap.error(f"--vocode is a share of the clips, from 0 to 1 (got {args.vocode})")
-    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode)
+    for name in ("vocode", "foreign"):
+        if not 0.0 <= getattr(args, name) <= 1.0:
+            ap.error(f"--{name} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
