@@ -6,7 +6,7 @@ front-end trains apart from the face, on this set:
 
 - Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds; with
   `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices);
-- festival, flite and espeak-ng voices (corpus/speech.py); with `--foreign SHARE`, that share of the clips said by
+- festival, flite and espeak-ng voices (corpus/speech.py); with `--foreign SHARE`, that share of the synthetic clips said by
   festival's Italian, Czech and Finnish diphone voices through a phone map (corpus/foreign.py): more voices of the
   older synthesisers' kind, which the front-end hears worst;
 - the recorded human speech of the corpus's train split (one speaker, real microphones).
@@ -79,8 +79,9 @@ KOKORO_VOICES = ("english", "accented", "all")
 
 def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0) -> list[SpeechSpec]:
     """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54.
-    `foreign_share`: the share of clips given instead to festival's foreign voices (corpus/foreign.py), drawn from a
-    generator of their own, so with 0 the plan is the one made before the option existed."""
+    `foreign_share`: the share of the synthetic clips given instead to festival's foreign voices (corpus/foreign.py;
+    the recorded speech stays), drawn from a generator of their own, so with 0 the plan is the one made before the
+    option existed."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
@@ -113,7 +114,7 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
                 b = k_voices[rng.integers(len(k_voices))]
                 a = f"{a}*{rng.uniform(0.3, 0.7):.2f}+{b}" if b != a else a
             specs.append(SpeechSpec(key, "kokoro", a, text, float(rng.uniform(0.85, 1.2)), clip_seed))
-        if others and frng.random() < foreign_share:
+        if others and frng.random() < foreign_share and specs[-1].engine != "human":  # the one real voice stays
             specs[-1] = SpeechSpec(key, "foreign", others[frng.integers(len(others))], text, float(frng.uniform(0.85, 1.15)), clip_seed)
     return specs
 
