@@ -21,7 +21,6 @@ the speech set records it as skipped.
 from __future__ import annotations
 
 import re
-import subprocess
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,7 +29,7 @@ import numpy as np
 
 from ..phones import BILABIALS, SILENCE
 from ..wav import read_wav, resample
-from .speech import SpeechToolError, Voice, require_tools, synthesize
+from .speech import SpeechToolError, Voice, _run, require_tools, synthesize
 
 FOREIGN_PACKAGES = ("festvox-italp16k", "festvox-itapc16k", "festvox-czech-dita", "festvox-czech-machac",
                     "festvox-suopuhe-lj", "festvox-suopuhe-mv")
@@ -151,13 +150,10 @@ def synthesize_foreign(name: str, text: str, sample_rate: int, speed: float = 1.
     with tempfile.TemporaryDirectory(prefix="tts-x-") as tmp:
         wav, seg_file, scm = Path(tmp) / "out.wav", Path(tmp) / "out.segs", Path(tmp) / "say.scm"
         scm.write_text(_scheme(voice, segs, wav, seg_file))
-        try:
-            r = subprocess.run(["festival", "-b", str(scm)], capture_output=True, text=True, timeout=120)
-        except subprocess.TimeoutExpired as e:
-            raise SpeechToolError("festival timed out after 120 s") from e
+        r = _run(["festival", "-b", str(scm)])
         missing = re.findall(r"using default diphone \S+ for (\S+)-(\S+)", r.stdout + r.stderr)
-        if r.returncode != 0 or not wav.exists():
-            raise SpeechToolError(f"festival failed for voice {name}: {(r.stderr or r.stdout).strip()[:300]}")
+        if not wav.exists():
+            raise SpeechToolError(f"festival wrote no audio for voice {name}: {(r.stderr or r.stdout).strip()[:300]}")
         said = [ln.split() for ln in seg_file.read_text().splitlines()]
         ends = [float(x[0]) for x in said if len(x) == 3 and x[0] != "#"]
         audio, sr = read_wav(wav)

@@ -14,7 +14,6 @@ import json
 import sys
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from ..data.datasets import open_dataset
@@ -38,20 +37,12 @@ def load_encoder(path: str) -> tuple[ContentEncoder, ModelConfig]:
 @torch.no_grad()
 def measure(enc: ContentEncoder, cfg: ModelConfig, clips) -> dict:
     """Over prepared clips: content_summary's figures for all of them, and voice_rows per voice."""
-    D = cfg.content_classes
-    conf, heard, by_voice = np.zeros((D, D), np.int64), [0, 0], {}
+    tally = art.ContentTally(cfg.content_classes)
     for c in clips:
-        logits = enc(torch.from_numpy(c.mel)[None])[0].numpy()
-        labels = c.phones[:: cfg.content_stride]
-        counts, (h, n) = art.content_counts(logits, labels, D), art.bilabial_heard(logits, labels)
-        conf += counts
-        heard[0] += h
-        heard[1] += n
-        v = by_voice.setdefault(art.voice_family(c.voice), [0, np.zeros((D, D), np.int64), 0, 0])
-        v[0], v[1], v[2], v[3] = v[0] + 1, v[1] + counts, v[2] + h, v[3] + n
-    s = art.content_summary(conf, tuple(heard))
+        tally.add(enc(torch.from_numpy(c.mel)[None])[0].numpy(), c.phones[:: cfg.content_stride], c.voice)
+    s = tally.summary()
     return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
-            "bilabial_segments": s["bilabial_segments"], "by_voice": art.voice_rows(by_voice)}
+            "bilabial_segments": s["bilabial_segments"], "by_voice": tally.voices()}
 
 
 def main(argv=None) -> int:

@@ -178,7 +178,8 @@ def build_one(args) -> dict:
 def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
           vocode_share: float = 0.0, foreign_share: float = 0.0) -> dict:
     """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
-    clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound."""
+    clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound. `foreign_share`:
+    the share of the synthetic clips said by festival's foreign voices (plan, corpus/foreign.py)."""
     out.mkdir(parents=True, exist_ok=True)
     specs = plan(minutes, seed, kokoro_voices, foreign_share)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()

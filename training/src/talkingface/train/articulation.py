@@ -170,6 +170,31 @@ def voice_rows(by_voice: dict) -> list[dict]:
     return sorted(rows, key=lambda r: -r["frames"])
 
 
+class ContentTally:
+    """The content encoder's counts over clips: the confusion matrix and /p b m/ segments heard, in all and per voice."""
+
+    def __init__(self, num_classes: int):
+        self.conf = np.zeros((num_classes, num_classes), np.int64)
+        self.heard = [0, 0]
+        self.by_voice: dict[str, list] = {}  # voice -> [clips, confusion, heard, segments]
+
+    def add(self, logits: np.ndarray, labels: np.ndarray, voice: str | None = None) -> None:
+        """One clip's (Kc, D) logits against its (Kc,) phone labels; `voice` (the clip's) also counts it per voice."""
+        counts, (h, n) = content_counts(logits, labels, len(self.conf)), bilabial_heard(logits, labels)
+        self.conf += counts
+        self.heard[0] += h
+        self.heard[1] += n
+        if voice is not None:
+            v = self.by_voice.setdefault(voice_family(voice), [0, np.zeros_like(self.conf), 0, 0])
+            v[0], v[1], v[2], v[3] = v[0] + 1, v[1] + counts, v[2] + h, v[3] + n
+
+    def summary(self) -> dict:
+        return content_summary(self.conf, tuple(self.heard))
+
+    def voices(self) -> list[dict]:
+        return voice_rows(self.by_voice)
+
+
 def markdown(res: dict) -> list[str]:
     """The articulation and content-encoder tables of docs/results/<model>.md."""
     pct = lambda x: f"{100 * x:.1f}%"

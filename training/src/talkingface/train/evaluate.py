@@ -40,10 +40,7 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     closers = lc.Closers(t, lip_closure, mouth_gain) if lip_closure is not None else None
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
     per_clip, artic, heads = [], [], []
-    D = model.cfg.content_classes
-    confusion = {"all": np.zeros((D, D), np.int64), "human": np.zeros((D, D), np.int64)}
-    heard = {"all": [0, 0], "human": [0, 0]}
-    by_voice: dict[str, list] = {}  # voice -> [clips, confusion, heard, segments]
+    tally = {"all": art.ContentTally(model.cfg.content_classes), "human": art.ContentTally(model.cfg.content_classes)}
     keys = ds.keys(split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
@@ -69,13 +66,9 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         with torch.no_grad():
             logits = model.content(mel[None])[0].numpy()                      # (Kc, D)
         labels = c.phones[:: model.cfg.content_stride]
-        counts, (h, n) = art.content_counts(logits, labels, D), art.bilabial_heard(logits, labels)
-        for group in ("all", "human") if c.source == "human" else ("all",):
-            confusion[group] += counts
-            heard[group][0] += h
-            heard[group][1] += n
-        v = by_voice.setdefault(art.voice_family(c.voice), [0, np.zeros((D, D), np.int64), 0, 0])
-        v[0], v[1], v[2], v[3] = v[0] + 1, v[1] + counts, v[2] + h, v[3] + n
+        tally["all"].add(logits, labels, c.voice)
+        if c.source == "human":
+            tally["human"].add(logits, labels)
         if progress:
             progress(i + 1, len(keys))
     names = [k for k in per_clip[0] if k not in ("key", "source", "frames")]
@@ -90,9 +83,8 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     human = [r for r in artic if r["source"] == "human"]
     articulation = {"all": art.summarise(artic), "synthetic": art.summarise([r for r in artic if r["source"] != "human"]),
                     "human": art.summarise(human)}
-    content = {"all": art.content_summary(confusion["all"], heard["all"]),
-               "human": art.content_summary(confusion["human"], heard["human"]) if human else None,
-               "by_voice": art.voice_rows(by_voice)}
+    content = {"all": tally["all"].summary(), "human": tally["human"].summary() if human else None,
+               "by_voice": tally["all"].voices()}
     if head_rows is not None:  # the per-clip speeds, for the Fig. 4 plot
         head_rows.extend(heads)
     head = {"all": hm.summarise(heads), "synthetic": hm.summarise([r for r in heads if r["source"] != "human"]),
