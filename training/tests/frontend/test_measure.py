@@ -17,3 +17,18 @@ def test_measure_matches_the_evaluation_and_counts_every_voice(corpus, trained_r
     assert r["by_voice"] == ce["by_voice"]
     assert sum(v["clips"] for v in r["by_voice"]) == len(corpus.keys("test"))
     assert "per voice" in capsys.readouterr().out
+
+
+def test_warps_average_the_log_posteriors_of_warped_mels(trained_run):
+    import numpy as np
+    import pytest
+    import torch
+    from talkingface.features import warp_mel
+    enc, _ = measure.load_encoder(str(trained_run / "final.pt"))
+    mel = np.random.default_rng(0).standard_normal((90, 80)).astype(np.float32) + 4
+    with torch.no_grad():
+        assert torch.equal(measure.heard(enc, mel), enc(torch.from_numpy(mel)[None])[0])
+        lp = [enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in (0.9, 1.1)]
+        torch.testing.assert_close(measure.heard(enc, mel, (0.9, 1.1)), (lp[0] + lp[1]) / 2)
+    with pytest.raises(SystemExit):
+        measure.main([str(trained_run / "final.pt"), "--corpus", "x", "--warps", "1,three"])

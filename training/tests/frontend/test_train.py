@@ -47,3 +47,26 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     assert fe2["args"]["speech"] == [str(speech), str(speech)] and fe2["args"]["init"] == str(out / "frontend.pt")
     for k in ("norm.mean", "norm.std"):
         torch.testing.assert_close(fe2["content"][k], fe["content"][k], rtol=0, atol=0)
+    # --channels widens it, and a face trained on the wider front-end takes its width
+    wide = tmp_path / "fe-wide"
+    fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(wide), "--steps", "2",
+                   "--eval-every", "1000", "--threads", "1", "--init", str(out / "frontend.pt"), "--channels", "160"])
+    fe3 = torch.load(wide / "frontend.pt", weights_only=False)
+    assert fe3["model_config"]["content_channels"] == 160 and fe3["content"]["out.weight"].shape[1] == 160
+    run2 = tmp_path / "run2"
+    train.main(["--corpus", str(corpus.root), "--out", str(run2), "--steps", "1", "--batch-clips", "2", "--frames", "4",
+                "--frontend", str(wide / "frontend.pt")])
+    assert train.load_checkpoint(run2 / "final.pt", corpus.template)[0].cfg.content_channels == 160
+
+
+def test_widening_keeps_the_function_and_the_new_channels_learn():
+    from talkingface.model.config import ModelConfig
+    from talkingface.model.encoders import ContentEncoder
+    torch.manual_seed(0)
+    narrow = ContentEncoder(ModelConfig(content_channels=32), 80).eval()
+    wide = fe_train.widen(narrow, ModelConfig(content_channels=48)).eval()
+    mel = torch.randn(2, 60, 80)
+    torch.testing.assert_close(wide(mel), narrow(mel), rtol=1e-5, atol=1e-5)
+    wide(mel).square().sum().backward()
+    grown = wide.blocks[0].conv.weight.grad[32:]  # the weights into the new channels: zero, with a gradient
+    assert wide.blocks[0].conv.weight[32:].abs().max() == 0 and grown.abs().max() > 0

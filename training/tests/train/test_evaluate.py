@@ -8,3 +8,39 @@ def test_evaluate_reports_the_paper_metrics(corpus, trained_run):
     for key in ("E_vl", "E_ve", "FDD", "AFDD", "pose_error_deg", "pose_jitter_deg"):
         assert key in res["all"]
     assert res["all"]["clips"] == len(corpus.keys("test"))
+
+
+def test_oracle_phones_are_what_the_face_decodes(corpus, trained_run):
+    import numpy as np
+    import torch
+    from talkingface.train.data import prepare
+    model, _ = train.load_checkpoint(trained_run / "final.pt", corpus.template)
+    model.eval()
+    c = prepare(corpus, corpus.keys("test")[0], model.audio)
+    stride, classes = model.cfg.content_stride, model.cfg.content_classes
+    oracle = evaluate.phone_logits(c.phones, stride, classes)
+    assert oracle.shape == (-(-len(c.mel) // stride), classes)
+    assert (oracle.argmax(-1).numpy() == c.phones[::stride]).all()
+    assert oracle.softmax(-1).max(-1).values.min() > 0.999
+    mel, tpl = torch.from_numpy(c.mel), torch.from_numpy(c.template)
+    heard = model.animate(mel, tpl, c.num_frames)["offsets"]
+    with torch.no_grad():
+        own = model.content(mel[None])[0]
+    # Given the encoder's own logits, the face is unchanged; given the alignment's, it moves otherwise.
+    assert torch.equal(model.animate(mel, tpl, c.num_frames, logits=own)["offsets"], heard)
+    assert not np.allclose(model.animate(mel, tpl, c.num_frames, logits=oracle)["offsets"].numpy(), heard.numpy(), atol=1e-3)
+
+
+def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, trained_run, tmp_path):
+    import pytest
+    import torch
+    from talkingface.model import head_motion
+    fitted, cache = tmp_path / "hm.pt", tmp_path / "hm.npz"
+    base = ["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--out", str(fitted), "--cache", str(cache)]
+    assert head_motion.main(base + ["--against-mean"]) == 0
+    fit = torch.load(fitted, weights_only=False)["head_motion_fit"]
+    assert fit == {"split": "train", "against_mean": True, "ridge": head_motion.SPEECH_RIDGE, "gain": "geometric mean over speakers"}
+    with pytest.raises(SystemExit, match="against-mean"):  # residuals from the mean pose are not the neutral pose's
+        head_motion.main(base)
+    res = {"head_motion": {"fit": fit}}
+    assert "--against-mean" in evaluate.hm.fit_note(res["head_motion"]["fit"])

@@ -1,6 +1,6 @@
 """Measure speech front-ends by themselves, side by side: frame accuracy, /p b m/ heard, and both per voice.
 
-  scripts/py -m talkingface.frontend.measure --corpus data/corpus [--split val,test] FRONTEND [FRONTEND ...] [--out F.json]
+  scripts/py -m talkingface.frontend.measure --corpus data/corpus [--split val,test] [--warps 0.92,1,1.08] FRONTEND [FRONTEND ...] [--out F.json]
 
 Each FRONTEND is a front-end file (frontend.train's frontend.pt) or a face checkpoint, whose content encoder is read
 (models/checkpoint.pt: the shipped one). The numbers are those of `talkingface.train.evaluate`'s content encoder
@@ -14,10 +14,11 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import torch
 
 from ..data.datasets import open_dataset
-from ..features import AudioConfig
+from ..features import AudioConfig, warp_mel
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
 from ..train import articulation as art
@@ -35,11 +36,19 @@ def load_encoder(path: str) -> tuple[ContentEncoder, ModelConfig]:
 
 
 @torch.no_grad()
-def measure(enc: ContentEncoder, cfg: ModelConfig, clips) -> dict:
+def heard(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...] = (1.0,)) -> torch.Tensor:
+    """(K, n_mels) log-Mel -> (Kc, D) logits; with several `warps`, the mean of the log-posteriors of the Mel axis
+    warped by each (test-time averaging over vocal-tract lengths, as the training's frequency warp)."""
+    if tuple(warps) == (1.0,):
+        return enc(torch.from_numpy(mel)[None])[0]
+    return torch.stack([enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]).mean(0)
+
+
+def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ...] = (1.0,)) -> dict:
     """Over prepared clips: content_summary's figures for all of them, and voice_rows per voice."""
     tally = art.ContentTally(cfg.content_classes)
     for c in clips:
-        tally.add(enc(torch.from_numpy(c.mel)[None])[0].numpy(), c.phones[:: cfg.content_stride], c.voice)
+        tally.add(heard(enc, c.mel, warps).numpy(), c.phones[:: cfg.content_stride], c.voice)
     s = tally.summary()
     return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
             "bilabial_segments": s["bilabial_segments"], "by_voice": tally.voices()}
@@ -51,16 +60,24 @@ def main(argv=None) -> int:
     ap.add_argument("frontends", nargs="+", help="front-end files (frontend.pt) or face checkpoints")
     ap.add_argument("--corpus", type=Path, required=True)
     ap.add_argument("--split", default="val,test", help="the corpus's splits to measure on, comma-separated (default: val,test)")
+    ap.add_argument("--warps", default="1", help="Mel-axis warp factors whose log-posteriors are averaged, comma-separated "
+                    "(default 1: the front-end as it runs; 0.92,1,1.08: test-time averaging over three vocal-tract lengths)")
     ap.add_argument("--out", type=Path, help="also write the figures here (JSON)")
     args = ap.parse_args(argv)
     args.split = [s for s in args.split.split(",") if s]
+    try:
+        warps = tuple(float(w) for w in args.warps.split(","))
+    except ValueError:
+        ap.error(f"--warps: {args.warps!r} is not a comma-separated list of numbers")
+    if any(not 0.5 <= w <= 2 for w in warps):
+        ap.error(f"--warps: factors between 0.5 and 2, not {args.warps}")
     ds = open_dataset(args.corpus)
     audio = AudioConfig()
     clips = {s: [prepare(ds, k, audio) for k in ds.keys(s)] for s in args.split}
     results = {}
     for path in args.frontends:
         enc, cfg = load_encoder(path)
-        results[path] = {s: measure(enc, cfg, clips[s]) for s in args.split}
+        results[path] = {s: measure(enc, cfg, clips[s], warps) for s in args.split}
     pct = lambda x: f"{100 * x:.1f}%"
     for s in args.split:
         print(f"\n{s} split ({len(clips[s])} clips): frame accuracy, /p b m/ segments heard")

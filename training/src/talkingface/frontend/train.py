@@ -36,6 +36,31 @@ TIME_MASKS, TIME_MASK_MAX = 2, 12   # SpecAugment: masks per crop and their larg
 FREQ_MASKS, FREQ_MASK_MAX = 2, 10   # and along the Mel bands
 
 
+def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncoder:
+    """`enc` with cfg.content_channels channels, computing the same function: every weight into a new channel is zero
+    (so new channels stay at zero, and the residual blocks pass the old ones through unchanged), and the weights out of
+    the new channels are small and random, so the gradient reaches them and they learn. Net2Net's idea
+    (Chen et al. 2016) by zeros instead of copies."""
+    wide = ContentEncoder(cfg, enc.norm.mean.numel())
+    g = torch.Generator().manual_seed(seed)
+    state = {}
+    for name, old in enc.state_dict().items():
+        new = torch.zeros_like(wide.state_dict()[name])
+        if new.shape == old.shape:
+            state[name] = old.clone()
+            continue
+        if any(a < b for a, b in zip(new.shape, old.shape)):
+            raise ValueError(f"widen: {name} is {tuple(old.shape)}, wider than {tuple(new.shape)}")
+        if new.dim() == 3 and new.shape[1] > old.shape[1]:  # (out, in, taps): columns out of the new input channels
+            fan_in = new.shape[1] * new.shape[2]
+            new[:, old.shape[1]:] = torch.randn(new.shape[0], new.shape[1] - old.shape[1], new.shape[2], generator=g) * (0.5 / fan_in ** 0.5)
+            new[old.shape[0]:] = 0
+        new[tuple(slice(0, n) for n in old.shape)] = old
+        state[name] = new
+    wide.load_state_dict(state)
+    return wide
+
+
 def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
     rows = [json.loads(l) for l in (folder / "index.jsonl").read_text().splitlines()]
     out = []
@@ -123,6 +148,9 @@ def main(argv=None) -> int:
                     "its Mel normalisation included); a new run: fresh optimiser and schedule")
     ap.add_argument("--no-corpus-train", action="store_true",
                     help="leave out the mesh corpus's train split (by default its speech trains the front-end too)")
+    ap.add_argument("--channels", type=int, default=ModelConfig.content_channels,
+                    help="the content encoder's width (default %(default)s); an --init front-end that is narrower is widened "
+                         "to it, computing the same function at the start (widen)")
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
@@ -132,7 +160,7 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     log = lambda *a: print(*a, file=sys.stderr, flush=True)
 
-    cfg, audio = ModelConfig(), AudioConfig()
+    cfg, audio = ModelConfig(content_channels=args.channels), AudioConfig()
     clips = [c for folder in args.speech for c in load_speech(folder)]
     ds = open_dataset(args.corpus)
     held = {split: [prepare(ds, k, audio) for k in ds.keys(split)] for split in ("val", "test")}
@@ -148,11 +176,16 @@ def main(argv=None) -> int:
     del allmel
     if args.init:
         init = load_frontend(args.init)
-        arch = {k: cfg.to_dict()[k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")}
-        if any(init["model_config"][k] != v for k, v in arch.items()):
-            raise SystemExit(f"--init: {args.init} has another content encoder than {arch}")
-        enc.load_state_dict(init["content"])
-        log(f"initialised from {args.init} ({init['step']} steps)")
+        arch = {k: cfg.to_dict()[k] for k in ("content_arch", "content_classes", "content_stride")}
+        init_cfg = ModelConfig.from_dict(init["model_config"])
+        if any(init["model_config"][k] != v for k, v in arch.items()) or init_cfg.content_channels > args.channels:
+            raise SystemExit(f"--init: {args.init} has another content encoder than {arch | {'content_channels': args.channels}} "
+                             f"(it has {init_cfg.content_channels} channels)")
+        narrow = ContentEncoder(init_cfg, audio.n_mels)
+        narrow.load_state_dict(init["content"])
+        enc = widen(narrow, cfg, args.seed) if init_cfg.content_channels < args.channels else narrow
+        log(f"initialised from {args.init} ({init['step']} steps" +
+            (f", widened from {init_cfg.content_channels} to {args.channels} channels)" if enc is not narrow else ")"))
     class_weight = torch.ones(cfg.content_classes)
     class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight
     opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)

@@ -103,10 +103,11 @@ class TalkingFace(nn.Module):
 
     @torch.no_grad()
     def animate(self, mel: torch.Tensor, template: torch.Tensor, n_frames: int, chunk: int = 64,
-                return_attention: bool = False) -> dict:
+                return_attention: bool = False, logits: torch.Tensor | None = None) -> dict:
         """Whole-clip inference, frames decoded in chunks so memory stays bounded:
-        (K, n_mels) log-Mel, (N, 3) template in mm -> offsets (F, N, 3), pose (F, 6), posed vertices."""
-        logits = self.content(mel[None])                                       # (1, Kc, D)
+        (K, n_mels) log-Mel, (N, 3) template in mm -> offsets (F, N, 3), pose (F, 6), posed vertices.
+        logits: (Kc, D) content logits to decode instead of the content encoder's (evaluate --oracle-phones)."""
+        logits = self.content(mel[None]) if logits is None else logits[None]   # (1, Kc, D)
         pose_feat, _ = self.pose_encoder(mel[None])                            # (1, K, d)
         idx = torch.from_numpy(frame_to_mel_index(np.arange(n_frames), self.audio)).clamp(max=mel.shape[0] - 1)
         offsets, poses, maps = [], [], []

@@ -30,11 +30,14 @@ from .train import load_checkpoint
 
 
 def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0,
-             lip_closure: float | None = None, mouth_gain: float = 1.0) -> dict:
+             lip_closure: float | None = None, mouth_gain: float = 1.0, oracle_phones: bool = False) -> dict:
     """The paper's metrics and the articulation and head-motion measures on `split`. `head`: the head's own motion
     (model/head_motion.py), drawn with `seed` and added to the predicted pose as the browser does; None: the mean pose.
     `lip_closure`: the reference gap (mm) that retargets the closure to each face as the browser does
-    (model/lip_closure.py), with the mouth's amplitude scaled by `mouth_gain`; None: the model's offsets as they are."""
+    (model/lip_closure.py), with the mouth's amplitude scaled by `mouth_gain`; None: the model's offsets as they are.
+    `oracle_phones`: the face decodes the alignment's phones (phone_logits) instead of what its content encoder heard,
+    so the articulation measures say what the face would do with a front-end that hears every phone; the content
+    encoder's own figures are still its own."""
     model.eval()
     t = ds.template
     closers = lc.Closers(t, lip_closure, mouth_gain) if lip_closure is not None else None
@@ -45,7 +48,8 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
         mel = torch.from_numpy(c.mel)
-        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames)
+        oracle = phone_logits(c.phones, model.cfg.content_stride, model.cfg.content_classes) if oracle_phones else None
+        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames, logits=oracle)
         pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
         if closers:
             pred_unposed = c.template[None] + closers(c.template).apply(out["offsets"].numpy())
@@ -94,6 +98,17 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
 
+ORACLE_LOGIT = 8.0  # the aligned phone's logit, every other class's is minus this: a posterior of 1 - 4e-6
+
+
+def phone_logits(phones: np.ndarray, stride: int, num_classes: int) -> torch.Tensor:
+    """The alignment's phone per Mel frame -> content logits (ceil(K / stride), D) that are certain of it."""
+    labels = torch.from_numpy(np.asarray(phones[::stride], np.int64))
+    logits = torch.full((len(labels), num_classes), -ORACLE_LOGIT)
+    logits[torch.arange(len(labels)), labels] = ORACLE_LOGIT
+    return logits
+
+
 def silence_probe(model, template, lip_closure: float | None = None, mouth_gain: float = 1.0) -> dict:
     """Two seconds of digital silence: how far apart does the model leave the inner lips (mm)?
     The corpus rig closes them in silence (about 0.4 mm, docs/corpus)."""
@@ -118,6 +133,9 @@ def main(argv=None) -> int:
     ap.add_argument("--head-seed", type=int, default=0, help="seed of the head's own motion (clip i draws with seed + i; when the checkpoint has one)")
     ap.add_argument("--mean-pose", action="store_true", help="measure the pose head's mean pose alone, without the head's own motion")
     ap.add_argument("--raw-lips", action="store_true", help="the model's offsets as they are, without the checkpoint's lip closure")
+    ap.add_argument("--oracle-phones", action="store_true",
+                    help="decode the alignment's phones instead of the content encoder's logits: the face with a front-end that "
+                         "hears every phone (a diagnosis of what limits articulation, not a result)")
     args = ap.parse_args(argv)
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
@@ -126,11 +144,14 @@ def main(argv=None) -> int:
     head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
     closure = ck["lip_closure"]["reference_gap_mm"] if "lip_closure" in ck and not args.raw_lips else None
     gain = float(ck["lip_closure"].get("mouth_gain", 1.0)) if closure is not None else 1.0
-    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain)
+    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain,
+                   oracle_phones=args.oracle_phones)
+    res["oracle_phones"] = args.oracle_phones
     res["lip_closure"] = {"reference_gap_mm": closure, "mouth_gain": gain} if closure is not None else None
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
     res["head_motion"]["sampled"] = {"seed": args.head_seed} if head is not None else None
+    res["head_motion"]["fit"] = ck.get("head_motion_fit") if head is not None else None
     res["eval_seconds"] = time.time() - t0
     a = res["all"]
     print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
@@ -168,8 +189,11 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
         f"Checkpoint `{args.checkpoint}`: {ck['step']} steps, {ck['trained_seconds'] / 60:.1f} min of training "
         f"({ck.get('world_size', 1)} process(es)). Made by",
         f"`scripts/py -m talkingface.train.evaluate --corpus {args.corpus} --checkpoint {args.checkpoint} --split {args.split} --out {args.out}"
-        f"{' --raw-lips' if getattr(args, 'raw_lips', False) else ''}`.",
+        f"{' --raw-lips' if getattr(args, 'raw_lips', False) else ''}{' --oracle-phones' if getattr(args, 'oracle_phones', False) else ''}`.",
         "",
+        *(["**Oracle phones**: the face decodes the alignment's phones (certain, one-hot) instead of what its content encoder",
+           "heard: what it would do with a front-end that hears every phone. A diagnosis, not a result; the content encoder's",
+           "table below is still its own.", ""] if getattr(args, "oracle_phones", False) else []),
         (f"Lip closure retargeted to each face's own lip gap (reference gap {res['lip_closure']['reference_gap_mm']:.3f} mm, "
          f"the mouth's amplitude x{res['lip_closure'].get('mouth_gain', 1.0):g}, "
          "`training/src/talkingface/model/lip_closure.py`), as the browser does." if res.get("lip_closure") else

@@ -85,6 +85,15 @@ def plot_speed_histogram(rows: list[dict], path: Path, title: str) -> None:
     plt.close(fig)
 
 
+def fit_note(fit: dict | None) -> str:
+    """How the checkpoint's head motion was fitted (model.head_motion records it), in words; empty when not recorded."""
+    if not fit:
+        return ""
+    origin = "from the model's mean pose (`--against-mean`)" if fit["against_mean"] else "from the neutral pose"
+    readout = f"speech read-out ridge {fit['ridge']:g}" if fit.get("ridge") is not None else "no speech read-out"
+    return f" Fitted on the {fit['split']} split, residuals {origin}, {readout}, gain on the {fit['gain']}."
+
+
 def markdown(res: dict, plot_name: str) -> list[str]:
     rows = []
     for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
@@ -105,7 +114,7 @@ def markdown(res: dict, plot_name: str) -> list[str]:
         "",
         *([f"Predicted: the pose head's mean pose plus the head's own motion (model/head_motion.py), test clip i drawn "
            f"with seed {res['head_motion']['sampled']['seed']} + i (so the measures average many draws); `--mean-pose` "
-           "measures the mean alone (spread ratio 0.11 before the head's own motion).", ""]
+           "measures the mean alone (spread ratio 0.11 before the head's own motion)." + fit_note(res["head_motion"].get("fit")), ""]
           if res["head_motion"].get("sampled") else ["Predicted: the pose head's mean pose alone.", ""]),
         "| clips | spread (deg) | spread ratio (pitch / yaw / roll) | speed (deg/frame) | speed W1 | follows speech | jitter (deg) |",
         "| --- | --- | --- | --- | --- | --- | --- |",
