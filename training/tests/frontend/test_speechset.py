@@ -43,6 +43,19 @@ def test_the_kokoro_voices_option_picks_english_accented_or_all(monkeypatch):
         speechset.plan(5, seed=0, kokoro_voices="accented")
 
 
+def test_the_accents_option_gives_kokoro_clips_an_accent_and_leaves_the_rest_of_the_plan(monkeypatch):
+    monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b"])
+    plain, accented = speechset.plan(20, seed=3), speechset.plan(20, seed=3, accent_share=0.5)
+    changed = [(a, b) for a, b in zip(plain, accented) if a != b]
+    k = sum(s.engine == "kokoro" for s in plain)
+    assert all(a.engine == b.engine == "kokoro" and b.voice.startswith(a.voice + "@") for a, b in changed)
+    assert 0.35 * k < len(changed) < 0.65 * k
+    accents = {b.voice.split("@")[1] for _, b in changed}
+    assert accents <= set(kokoro.ACCENTS) and len(accents) >= 3 and "en-gb-scotland" not in kokoro.ACCENTS
+    with pytest.raises(ValueError, match="unknown accent"):
+        kokoro.phonemes("a pin", False, "en-gb-scotland")
+
+
 def test_an_accented_voice_reads_its_own_style_table(monkeypatch, tmp_path):
     import numpy as np
     (tmp_path / "voices").mkdir()

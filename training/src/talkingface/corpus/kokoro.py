@@ -167,16 +167,27 @@ def style(name: str, n_tokens: int) -> np.ndarray:
     return _style_table(name)[row]
 
 
-def phonemes(text: str, british: bool) -> str:
-    out = subprocess.run(["espeak-ng", "-q", "--ipa", "-v", "en-gb" if british else "en-us", text],
+# espeak-ng's English accents whose phonemes a Kokoro voice can be given instead of its own US or UK English
+# (the voice then speaks with that accent): Caribbean, New York, Lancaster, West Midlands, Received Pronunciation.
+# Not the Scottish accent: the mesh corpus's test split holds it out (corpus/plan.py, is_test_voice).
+ACCENTS = ("en-029", "en-us-nyc", "en-gb-x-gbclan", "en-gb-x-gbcwmd", "en-gb-x-rp")
+
+
+def phonemes(text: str, british: bool, accent: str | None = None) -> str:
+    """espeak-ng's IPA of `text` in US or UK English, or in `accent` (one of ACCENTS) when given."""
+    if accent is not None and accent not in ACCENTS:
+        raise ValueError(f"unknown accent {accent!r}: one of {', '.join(ACCENTS)}")
+    out = subprocess.run(["espeak-ng", "-q", "--ipa", "-v", accent or ("en-gb" if british else "en-us"), text],
                          capture_output=True, text=True, check=True).stdout
     return " ".join(out.split())
 
 
 def synthesize(name: str, text: str, speed: float = 1.0) -> np.ndarray:
-    """Speech of `text` in voice `name` (or a blend), mono float32 at KOKORO_RATE."""
+    """Speech of `text` in voice `name` (or a blend), mono float32 at KOKORO_RATE. A name ending in "@ACCENT"
+    ("af_heart@en-029") speaks with that accent's phonemes (ACCENTS)."""
     session, vocab = _session()
-    ipa = phonemes(text, british=name.startswith("b")).replace("r", "ɹ")
+    name, _, accent = name.partition("@")
+    ipa = phonemes(text, british=name.startswith("b"), accent=accent or None).replace("r", "ɹ")
     ids = [vocab[c] for c in ipa if c in vocab][: MAX_TOKENS - 2]
     tokens = np.array([[0, *ids, 0]], dtype=np.int64)
     s = style(name, len(ids))[None].astype(np.float32)

@@ -5,7 +5,8 @@ speech from a few dozen voices; phone recognition is limited by how many voices 
 front-end trains apart from the face, on this set:
 
 - Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds; with
-  `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices);
+  `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices); with
+  `--accents SHARE`, that share of them given the phonemes of one of espeak-ng's English accents (kokoro.ACCENTS);
 - festival, flite and espeak-ng voices (corpus/speech.py); with `--foreign SHARE`, that share of the synthetic clips said by
   festival's Italian, Czech and Finnish diphone voices through a phone map (corpus/foreign.py): more voices of the
   older synthesisers' kind, which the front-end hears worst;
@@ -77,11 +78,13 @@ def texts(n: int, seed: int) -> list[str]:
 KOKORO_VOICES = ("english", "accented", "all")
 
 
-def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0) -> list[SpeechSpec]:
+def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0,
+         accent_share: float = 0.0) -> list[SpeechSpec]:
     """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54.
     `foreign_share`: the share of the synthetic clips given instead to festival's foreign voices (corpus/foreign.py;
     the recorded speech stays), drawn from a generator of their own, so with 0 the plan is the one made before the
-    option existed."""
+    option existed. `accent_share`: the share of Kokoro's clips said with one of espeak-ng's English accents
+    (kokoro.ACCENTS: the voice name gets "@accent"), from a generator of its own too."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
@@ -95,6 +98,7 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
     if foreign_share > 0 and not others:
         raise foreign.SpeechToolError("festival's foreign voices are not installed: run `scripts/py -m talkingface.corpus setup --foreign-voices`")
     frng = np.random.default_rng([seed, 2])
+    arng = np.random.default_rng([seed, 3])
     humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
     for i in range(n):
@@ -114,6 +118,10 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
                 b = k_voices[rng.integers(len(k_voices))]
                 a = f"{a}*{rng.uniform(0.3, 0.7):.2f}+{b}" if b != a else a
             specs.append(SpeechSpec(key, "kokoro", a, text, float(rng.uniform(0.85, 1.2)), clip_seed))
+        if accent_share > 0:  # drawn for every clip, so the accents do not depend on which clips are Kokoro's
+            accented, accent = arng.random() < accent_share, kokoro.ACCENTS[arng.integers(len(kokoro.ACCENTS))]
+            if accented and specs[-1].engine == "kokoro":
+                specs[-1] = SpeechSpec(key, "kokoro", f"{specs[-1].voice}@{accent}", text, specs[-1].speed, clip_seed)
         if others and frng.random() < foreign_share and specs[-1].engine != "human":  # the one real voice stays
             specs[-1] = SpeechSpec(key, "foreign", others[frng.integers(len(others))], text, float(frng.uniform(0.85, 1.15)), clip_seed)
     return specs
@@ -176,12 +184,13 @@ def build_one(args) -> dict:
 
 
 def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
-          vocode_share: float = 0.0, foreign_share: float = 0.0) -> dict:
+          vocode_share: float = 0.0, foreign_share: float = 0.0, accent_share: float = 0.0) -> dict:
     """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
     clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound. `foreign_share`:
-    the share of the synthetic clips said by festival's foreign voices (plan, corpus/foreign.py)."""
+    the share of the synthetic clips said by festival's foreign voices (plan, corpus/foreign.py). `accent_share`: the share
+    of Kokoro's clips said with an espeak-ng accent (plan)."""
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed, kokoro_voices, foreign_share)[:first]
+    specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -219,11 +228,14 @@ def main(argv=None) -> int:
     ap.add_argument("--foreign", type=float, default=0.0, metavar="SHARE",
                     help="give this share of the clips to festival's Italian, Czech and Finnish voices speaking English "
                          "(setup --foreign-voices; corpus/foreign.py) (default 0)")
+    ap.add_argument("--accents", type=float, default=0.0, metavar="SHARE",
+                    help="say this share of Kokoro's clips with one of espeak-ng's English accents (Caribbean, New York, "
+                         "Lancaster, West Midlands, RP; not the Scottish one, which the test split holds out) (default 0)")
     args = ap.parse_args(argv)
-    for name in ("vocode", "foreign"):
+    for name in ("vocode", "foreign", "accents"):
         if not 0.0 <= getattr(args, name) <= 1.0:
             ap.error(f"--{name} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
-    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign)
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign, args.accents)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
