@@ -287,19 +287,16 @@ def main(argv=None) -> int:
 
     if args.cache and args.cache.exists():
         data = np.load(args.cache)
-        if "speakers" not in data or "against_mean" not in data:
-            raise SystemExit(f"{args.cache} was written by an earlier version (no speakers or no --against-mean record): "
-                             "delete it and run again")
-        if bool(data["against_mean"]) != args.against_mean:
-            raise SystemExit(f"{args.cache} holds residuals {'from the mean pose' if data['against_mean'] else 'from the neutral pose'}; "
-                             f"this run asks for {'--against-mean' if args.against_mean else 'no --against-mean'}: another --cache")
+        if not ("speakers" in data and "against_mean" in data and bool(data["against_mean"]) == args.against_mean):
+            raise SystemExit(f"{args.cache} holds another run's residuals (the other --against-mean, or an earlier version): "
+                             "delete it or give another --cache")
         n = int(data["clips"])
         residuals, feats, speakers = [data[f"r{i}"] for i in range(n)], [data[f"f{i}"] for i in range(n)], data["speakers"].tolist()
     else:
         residuals, feats, speakers = collect(model, ds, "train", progress, args.against_mean)
         if args.cache:
-            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), against_mean=args.against_mean, **{f"r{i}": r for i, r in enumerate(residuals)},
-                     **{f"f{i}": f for i, f in enumerate(feats)})
+            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), **{f"r{i}": r for i, r in enumerate(residuals)},
+                     against_mean=args.against_mean, **{f"f{i}": f for i, f in enumerate(feats)})
     from ..corpus.clip import neck_pivot
     template_mm = ds.template.vertices.astype(np.float64) * ds.mm_per_unit
     hm = fit(residuals, feats, neck_pivot(template_mm, ds.template), None if args.no_speech else args.ridge,
@@ -321,10 +318,8 @@ def main(argv=None) -> int:
         t, m = (motion_stats([x for x, s in zip(xs, group) if s == g])["spread"] for xs in (residuals, drawn))
         print(f"  {g}: spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
     ck["head_motion"] = hm.to_dict()
-    # How it was fitted, so an evaluation of the checkpoint can say which recipe it measures.
-    ck["head_motion_fit"] = {"split": "train", "against_mean": args.against_mean,
-                             "ridge": None if args.no_speech else args.ridge,
-                             "gain": "mean over clips" if args.per_clip else "geometric mean over speakers"}
+    ck["head_motion_fit"] = {"split": "train", "against_mean": args.against_mean, "ridge": None if args.no_speech else args.ridge,
+                             "gain": "mean over clips" if args.per_clip else "geometric mean over speakers"}  # evaluate says it
     torch.save(ck, args.out or args.checkpoint)
     print(f"wrote {args.out or args.checkpoint}")
     return 0
