@@ -116,17 +116,11 @@ def forward_augmented(enc: ContentEncoder, mel: torch.Tensor, rng) -> torch.Tens
 @torch.no_grad()
 def evaluate(enc: ContentEncoder, clips, num_classes: int, stride: int) -> dict:
     enc.eval()
-    conf = np.zeros((num_classes, num_classes), np.int64)
-    heard = [0, 0]
+    tally = art.ContentTally(num_classes)
     for c in clips:
-        logits = enc(torch.from_numpy(c.mel)[None])[0].numpy()
-        labels = c.phones[::stride]
-        conf += art.content_counts(logits, labels, num_classes)
-        h, n = art.bilabial_heard(logits, labels)
-        heard[0] += h
-        heard[1] += n
+        tally.add(enc(torch.from_numpy(c.mel)[None])[0].numpy(), c.phones[::stride])
     enc.train()
-    return art.content_summary(conf, tuple(heard))
+    return tally.summary()
 
 
 def main(argv=None) -> int:

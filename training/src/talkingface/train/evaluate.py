@@ -48,8 +48,10 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
         mel = torch.from_numpy(c.mel)
-        oracle = phone_logits(c.phones, model.cfg.content_stride, model.cfg.content_classes) if oracle_phones else None
-        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames, logits=oracle)
+        with torch.no_grad():
+            heard = model.content(mel[None])[0]                               # (Kc, D): once, for the face and the tally
+        decoded = phone_logits(c.phones, model.cfg.content_stride, model.cfg.content_classes) if oracle_phones else heard
+        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames, logits=decoded)
         pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
         if closers:
             pred_unposed = c.template[None] + closers(c.template).apply(out["offsets"].numpy())
@@ -67,8 +69,7 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         artic.append(a | {"source": c.source})
         mel_index = frame_to_mel_index(np.arange(c.num_frames), model.audio)
         heads.append(hm.clip_head_motion(c.pose, pred_pose, hm.envelope(c.mel, mel_index)) | {"source": c.source})
-        with torch.no_grad():
-            logits = model.content(mel[None])[0].numpy()                      # (Kc, D)
+        logits = heard.numpy()
         labels = c.phones[:: model.cfg.content_stride]
         tally["all"].add(logits, labels, c.voice)
         if c.source == "human":
