@@ -199,7 +199,7 @@ def markdown(res: dict) -> list[str]:
     """The articulation and content-encoder tables of docs/results/<model>.md."""
     pct = lambda x: f"{100 * x:.1f}%"
     rows = []
-    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
         a, m = res["articulation"][name], res[name]
         if a:
             rows.append(f"| {label} | {a['bilabial_segments']} | {pct(a['true_closure'])} / **{pct(a['pred_closure'])}** / "
@@ -207,7 +207,7 @@ def markdown(res: dict) -> list[str]:
                         f"{pct(a['true_open_vowel_opened'])} / {pct(a['pred_open_vowel_opened'])} | {a['gap_corr']:.2f} | "
                         f"{a['gap_std_ratio']:.2f} | {m['lip_motion_pred'] / m['lip_motion_gt']:.2f} |")
     crow = []
-    for name, label in (("all", "all test clips"), ("human", "recorded human speech")):
+    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("human", "recorded human speech")):
         c = res["content_encoder"][name]
         if c:
             rec = lambda p: pct(c["recall"][p]["recall"]) if p in c["recall"] else "-"

@@ -147,7 +147,7 @@ def main(argv=None) -> int:
     gain = float(ck["lip_closure"].get("mouth_gain", 1.0)) if closure is not None else 1.0
     res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain,
                    oracle_phones=args.oracle_phones)
-    res["oracle_phones"] = args.oracle_phones
+    res["oracle_phones"], res["split"] = args.oracle_phones, args.split
     res["lip_closure"] = {"reference_gap_mm": closure, "mouth_gain": gain} if closure is not None else None
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
                          "model_config": ck["model_config"]}
@@ -178,7 +178,7 @@ def main(argv=None) -> int:
 def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
     cfg = ck["model_config"]
     rows = []
-    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+    for name, label in (("all", f"all {args.split} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
         r = res[name]
         if r:
             rows.append(f"| {label} | {r['clips']} | {r['E_vl']:.3f} | {r['E_ve']:.3f} | {r['E_vl_posed']:.3f} | {r['FDD']:.4f} | "

@@ -96,7 +96,7 @@ def fit_note(fit: dict | None) -> str:
 
 def markdown(res: dict, plot_name: str) -> list[str]:
     rows = []
-    for name, label in (("all", "all test clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
+    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
         h, m = res["head_motion"][name], res[name]
         if h:
             ax = h["spread_ratio_axes"]
