@@ -56,6 +56,30 @@ def test_the_accents_option_gives_kokoro_clips_an_accent_and_leaves_the_rest_of_
         kokoro.phonemes("a pin", False, "en-gb-scotland")
 
 
+def test_the_extrapolate_option_gives_kokoro_clips_a_voice_beyond_two_and_leaves_the_rest_of_the_plan(monkeypatch, tmp_path):
+    import numpy as np
+    monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b", "am_c"])
+    plain, beyond = speechset.plan(20, seed=3), speechset.plan(20, seed=3, extrapolate_share=0.5)
+    changed = [(a, b) for a, b in zip(plain, beyond) if a != b]
+    k = sum(s.engine == "kokoro" for s in plain)
+    assert all(a.engine == b.engine == "kokoro" and (a.key, a.text, a.speed) == (b.key, b.text, b.speed) for a, b in changed)
+    assert 0.25 * k < len(changed) < 0.65 * k
+    for _, b in changed:
+        first, second = b.voice.split("+")
+        name, w = first.split("*")
+        assert speechset.EXTRAPOLATE[0] <= float(w) <= speechset.EXTRAPOLATE[1] and name != second
+    # The style vector lies beyond the first voice, away from the second: w a + (1 - w) b.
+    (tmp_path / "voices").mkdir()
+    np.full((510, 256), 1.0, "<f4").tofile(tmp_path / "voices" / "af_a.bin")
+    np.full((510, 256), 3.0, "<f4").tofile(tmp_path / "voices" / "bm_b.bin")
+    monkeypatch.setattr(kokoro, "HOME", tmp_path)
+    kokoro._style_table.cache_clear()
+    try:
+        assert kokoro.style("af_a*1.5+bm_b", 12)[0] == 1.5 * 1.0 - 0.5 * 3.0
+    finally:
+        kokoro._style_table.cache_clear()
+
+
 def test_an_accented_voice_reads_its_own_style_table(monkeypatch, tmp_path):
     import numpy as np
     (tmp_path / "voices").mkdir()
@@ -93,3 +117,40 @@ def test_the_vocoder_keeps_the_words_and_replaces_the_source():
     z = vocode(noise, sr, np.random.default_rng(2))
     zc = np.correlate(z[4000:12000], z[4000:12000], "full")[7999:]
     assert zc[int(sr / 300):int(sr / 80)].max() < 0.3 * zc[0]  # no pitch where there was none
+
+
+def test_the_more_voices_option_gives_synthetic_clips_to_rhvoice_and_pico_and_leaves_the_rest(monkeypatch):
+    from talkingface.corpus import more_voices
+    monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b"])
+    monkeypatch.setattr(more_voices, "available", lambda: ["rhvoice:bdl", "pico:en-GB"])
+    plain, more = speechset.plan(20, seed=3), speechset.plan(20, seed=3, more_share=0.3)
+    changed = [(a, b) for a, b in zip(plain, more) if a != b]
+    synthetic = sum(s.engine != "human" for s in plain)
+    assert all(a.engine != "human" and b.engine == "more" and (a.key, a.text) == (b.key, b.text) for a, b in changed)
+    assert 0.15 * synthetic < len(changed) < 0.45 * synthetic
+    assert {b.voice for _, b in changed} == {"rhvoice:bdl", "pico:en-GB"}
+    monkeypatch.setattr(more_voices, "available", lambda: [])
+    with pytest.raises(RuntimeError, match="setup --more-voices"):
+        speechset.plan(5, seed=0, more_share=0.3)
+
+
+def test_more_voices_keeps_the_test_splits_accent_and_non_free_voices_out_and_names_a_missing_tool(monkeypatch):
+    from talkingface.corpus import more_voices
+    from talkingface.corpus.speech import SpeechToolError
+    voices = {v for _, v in more_voices.VOICES}
+    assert "alan" not in voices and not voices & {"evgeniy-eng", "lyubov"}  # Scottish (held out by the test split); CC-BY-NC-ND
+    with pytest.raises(ValueError, match="unknown voice"):
+        more_voices.synthesize("rhvoice:alan", "a pin", 16000)
+    monkeypatch.setattr(more_voices.shutil, "which", lambda tool: None)
+    assert more_voices.available() == []
+    with pytest.raises(SpeechToolError, match="setup --more-voices"):
+        more_voices.synthesize("pico:en-US", "a pin", 16000)
+
+
+@pytest.mark.skipif(not __import__("shutil").which("RHVoice-test") or not __import__("shutil").which("pico2wave"),
+                    reason="RHVoice and Pico missing: scripts/py -m talkingface.corpus setup --more-voices")
+def test_every_more_voice_says_a_sentence():
+    from talkingface.corpus import more_voices
+    for name in more_voices.available():
+        audio = more_voices.synthesize(name, "Maybe the bob will pump the map.", 16000)
+        assert 1.2 < len(audio) / 16000 < 4.0 and 0.01 < float(abs(audio).max()) <= 1.0, name

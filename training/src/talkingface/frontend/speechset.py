@@ -7,9 +7,13 @@ front-end trains apart from the face, on this set:
 - Kokoro-82M's 28 natural English voices (corpus/kokoro.py), and blends of two of them, at varied speeds; with
   `--kokoro-voices accented|all`, its 26 other-language voices speaking English (accented voices); with
   `--accents SHARE`, that share of them given the phonemes of one of espeak-ng's English accents (kokoro.ACCENTS);
+  with `--extrapolate SHARE`, that share of them said by a voice beyond two of Kokoro's (EXTRAPOLATE: a speaker
+  that is neither, and not between them);
 - festival, flite and espeak-ng voices (corpus/speech.py); with `--foreign SHARE`, that share of the synthetic clips said by
   festival's Italian, Czech and Finnish diphone voices through a phone map (corpus/foreign.py): more voices of the
   older synthesisers' kind, which the front-end hears worst;
+- with `--more-voices SHARE`, that share of the synthetic clips said by RHVoice's and SVOX Pico's English voices
+  (corpus/more_voices.py): two more synthesiser families;
 - the recorded human speech of the corpus's train split (one speaker, real microphones).
 
 Phone labels: the synthesiser's own timings (festival, flite) or pocketsphinx forced alignment (the rest).
@@ -35,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..corpus import foreign, kokoro, recorded
+from ..corpus import foreign, kokoro, more_voices, recorded
 from ..corpus.align import AlignmentError, Aligner
 from ..corpus.augment import augment_channel, augment_speech, vocode
 from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
@@ -78,13 +82,22 @@ def texts(n: int, seed: int) -> list[str]:
 KOKORO_VOICES = ("english", "accented", "all")
 
 
+# A voice beyond two of Kokoro's: w a + (1 - w) b with w drawn from this range, a style vector on the far side of a
+# from b. The front-end hears these as new speakers (the shipped one: 70% of frames at w = 1.5 against 88% for a
+# itself, on eight sentences); past about 2 the speech itself degrades.
+EXTRAPOLATE = (1.2, 1.8)
+
+
 def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0,
-         accent_share: float = 0.0) -> list[SpeechSpec]:
+         accent_share: float = 0.0, extrapolate_share: float = 0.0, more_share: float = 0.0) -> list[SpeechSpec]:
     """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54.
     `foreign_share`: the share of the synthetic clips given instead to festival's foreign voices (corpus/foreign.py;
     the recorded speech stays), drawn from a generator of their own, so with 0 the plan is the one made before the
     option existed. `accent_share`: the share of Kokoro's clips said with one of espeak-ng's English accents
-    (kokoro.ACCENTS: the voice name gets "@accent"), from a generator of its own too."""
+    (kokoro.ACCENTS: the voice name gets "@accent"), from a generator of its own too. `extrapolate_share`: the share of
+    Kokoro's clips whose voice is one beyond two of them ("a*w+b" with w > 1, EXTRAPOLATE), its generator its own.
+    `more_share`: the share of the synthetic clips given to RHVoice's and Pico's voices (corpus/more_voices.py), drawn
+    after the foreign voices, from a generator of its own."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
@@ -99,6 +112,11 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
         raise foreign.SpeechToolError("festival's foreign voices are not installed: run `scripts/py -m talkingface.corpus setup --foreign-voices`")
     frng = np.random.default_rng([seed, 2])
     arng = np.random.default_rng([seed, 3])
+    xrng = np.random.default_rng([seed, 4])
+    mrng = np.random.default_rng([seed, 5])
+    more = more_voices.available() if more_share > 0 else []
+    if more_share > 0 and not more:
+        raise foreign.SpeechToolError("RHVoice and Pico are not installed: run `scripts/py -m talkingface.corpus setup --more-voices`")
     humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
     for i in range(n):
@@ -122,8 +140,16 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
             accented, accent = arng.random() < accent_share, kokoro.ACCENTS[arng.integers(len(kokoro.ACCENTS))]
             if accented and specs[-1].engine == "kokoro":
                 specs[-1] = SpeechSpec(key, "kokoro", f"{specs[-1].voice}@{accent}", text, specs[-1].speed, clip_seed)
+        if extrapolate_share > 0:  # drawn for every clip, as the accents
+            beyond, pair, w = xrng.random() < extrapolate_share, xrng.integers(len(k_voices), size=2), xrng.uniform(*EXTRAPOLATE)
+            if beyond and specs[-1].engine == "kokoro" and pair[0] != pair[1]:
+                voice, _, accent = specs[-1].voice.partition("@")
+                voice = f"{k_voices[pair[0]]}*{w:.2f}+{k_voices[pair[1]]}" + (f"@{accent}" if accent else "")
+                specs[-1] = SpeechSpec(key, "kokoro", voice, text, specs[-1].speed, clip_seed)
         if others and frng.random() < foreign_share and specs[-1].engine != "human":  # the one real voice stays
             specs[-1] = SpeechSpec(key, "foreign", others[frng.integers(len(others))], text, float(frng.uniform(0.85, 1.15)), clip_seed)
+        if more and mrng.random() < more_share and specs[-1].engine != "human":
+            specs[-1] = SpeechSpec(key, "more", more[mrng.integers(len(more))], text, 1.0, clip_seed)
     return specs
 
 
@@ -142,6 +168,8 @@ def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
         phones = None
     elif spec.engine == "foreign":
         audio, phones = foreign.synthesize_foreign(spec.voice, spec.text, sr, spec.speed, spec.seed)
+    elif spec.engine == "more":
+        audio, phones = more_voices.synthesize(spec.voice, spec.text, sr), None
     elif spec.engine == "kokoro":
         audio = resample(kokoro.synthesize(spec.voice, spec.text, spec.speed), kokoro.KOKORO_RATE, sr)
         audio = np.concatenate([np.zeros(int(0.2 * sr), np.float32), audio, np.zeros(int(0.2 * sr), np.float32)])
@@ -184,13 +212,15 @@ def build_one(args) -> dict:
 
 
 def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
-          vocode_share: float = 0.0, foreign_share: float = 0.0, accent_share: float = 0.0) -> dict:
+          vocode_share: float = 0.0, foreign_share: float = 0.0, accent_share: float = 0.0, extrapolate_share: float = 0.0,
+          more_share: float = 0.0) -> dict:
     """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
     clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound. `foreign_share`:
     the share of the synthetic clips said by festival's foreign voices (plan, corpus/foreign.py). `accent_share`: the share
-    of Kokoro's clips said with an espeak-ng accent (plan)."""
+    of Kokoro's clips said with an espeak-ng accent (plan). `extrapolate_share`: the share of Kokoro's clips said by a
+    voice beyond two of its voices (plan). `more_share`: the share of the synthetic clips said by RHVoice's and Pico's voices."""
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share)[:first]
+    specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share, extrapolate_share, more_share)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -231,11 +261,18 @@ def main(argv=None) -> int:
     ap.add_argument("--accents", type=float, default=0.0, metavar="SHARE",
                     help="say this share of Kokoro's clips with one of espeak-ng's English accents (Caribbean, New York, "
                          "Lancaster, West Midlands, RP; not the Scottish one, which the test split holds out) (default 0)")
+    ap.add_argument("--extrapolate", type=float, default=0.0, metavar="SHARE",
+                    help="say this share of Kokoro's clips with a voice beyond two of its voices (w a + (1 - w) b, "
+                         f"w from {EXTRAPOLATE[0]} to {EXTRAPOLATE[1]}): speakers that are none of its 54 (default 0)")
+    ap.add_argument("--more-voices", type=float, default=0.0, metavar="SHARE",
+                    help="give this share of the synthetic clips to RHVoice's and SVOX Pico's English voices "
+                         "(setup --more-voices; corpus/more_voices.py) (default 0)")
     args = ap.parse_args(argv)
-    for name in ("vocode", "foreign", "accents"):
+    for name in ("vocode", "foreign", "accents", "extrapolate", "more_voices"):
         if not 0.0 <= getattr(args, name) <= 1.0:
-            ap.error(f"--{name} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
-    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign, args.accents)
+            ap.error(f"--{name.replace('_', '-')} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
+    meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign, args.accents,
+                 args.extrapolate, args.more_voices)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
