@@ -28,10 +28,19 @@ export const ui = {
   exportGlbButton: $<HTMLButtonElement>('export-glb'),
   exportRawButton: $<HTMLButtonElement>('export-raw'),
   headRerollButton: $<HTMLButtonElement>('head-reroll'),
+  headScale: $<HTMLInputElement>('head-scale'),
   stage: $<HTMLElement>('stage'),
   dropHint: $<HTMLParagraphElement>('drop-hint'),
   timeline: $<HTMLCanvasElement>('timeline'),
 };
+
+/** What changes when the head's own motion is drawn again: the next seed (New head motion), or its scale (the slider). */
+export type HeadChange = { nextSeed?: boolean; scale?: number };
+
+/** The head-motion slider's value in words, for screen readers and the details. */
+export function headScaleText(scale: number): string {
+  return scale === 1 ? '1 times, as learnt' : scale === 0 ? '0: the head keeps its mean pose' : `${scale} times, ${scale < 1 ? 'calmer' : 'livelier'}`;
+}
 
 /** The status line: one short sentence of what happened and what to do next (the full text also on hover). */
 export function showStatus(text: string, isError = false): void {
@@ -91,8 +100,8 @@ export interface ControlActions {
   setBackend(choice: string): void;
   exportGlb(): void;
   exportRaw(): void;
-  /** Draw the head's own motion again with another seed. */
-  rerollHead(): void;
+  /** Draw the head's own motion again: with another seed, or scaled (1: as learnt). */
+  redrawHead(change: HeadChange): void;
 }
 
 export function bindControls(a: ControlActions): void {
@@ -109,7 +118,9 @@ export function bindControls(a: ControlActions): void {
   });
   ui.exportGlbButton.addEventListener('click', () => a.exportGlb());
   ui.exportRawButton.addEventListener('click', () => a.exportRaw());
-  ui.headRerollButton.addEventListener('click', () => a.rerollHead());
+  ui.headRerollButton.addEventListener('click', () => a.redrawHead({ nextSeed: true }));
+  ui.headScale.addEventListener('input', () => ui.headScale.setAttribute('aria-valuetext', headScaleText(Number(ui.headScale.value))));
+  ui.headScale.addEventListener('change', () => a.redrawHead({ scale: Number(ui.headScale.value) }));
   ui.fileInput.addEventListener('change', () => {
     const file = ui.fileInput.files?.[0];
     if (file) a.openFile(file);

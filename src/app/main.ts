@@ -16,7 +16,7 @@ import { fetchSample, fillSampleSelect, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, switchBackend, takeDetails } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
-import { ui, showStatus, tell, announce, lockWidth, bindControls } from './controls';
+import { ui, showStatus, tell, announce, lockWidth, bindControls, type HeadChange } from './controls';
 import { bindKeys } from './keyboard';
 import { innerLipGaps } from '../template/lip-gap';
 
@@ -191,16 +191,19 @@ function setTake(t: Take, notes: string[] = []): Take {
   ui.exportInfo.textContent = '';
   takeNote = notes.length ? `${t.name}: ${notes[0]}.` : '';
   for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = false;
-  ui.headRerollButton.disabled = !engine?.hasHeadMotion;
+  ui.headRerollButton.disabled = ui.headScale.disabled = !engine?.hasHeadMotion;
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
   player.show(0);
   return t;
 }
 
-/** The same take with the head's own motion drawn again (the lips and eyes do not change). */
-const rerollHead = (): Promise<void> => (take && engine?.hasHeadMotion
-  ? animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal))) : Promise.resolve());
+/** The take's head motion drawn again, with the next seed or at a new scale (the lips and eyes do not change). */
+function redrawTakeHead(change: HeadChange): void {
+  if (!engine?.hasHeadMotion) return;
+  if (change.scale !== undefined) engine.headMotionScale = change.scale;
+  if (take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, Boolean(change.nextSeed))));
+}
 
 function play(): void {
   if (!take) return;
@@ -285,10 +288,7 @@ function escape(): boolean {
 }
 
 const togglePlay = (): void => (player?.isPlaying ? stopPlayback() : play());
-const showFrame = (frame: number): void => {
-  stopPlayback();
-  player.show(frame);
-};
+const showFrame = (frame: number): void => { stopPlayback(); player.show(frame); };
 
 bindControls({
   openFile: (file) => void animateFile(file),
@@ -310,7 +310,7 @@ bindControls({
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
-  rerollHead: () => void rerollHead(),
+  redrawHead: redrawTakeHead,
 });
 
 bindKeys({

@@ -114,9 +114,12 @@ export class TakeView {
   }
 }
 
-/** The take with the head's own motion drawn with the next seed (the lips and eyes do not change). */
-export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal): Promise<Take> {
-  e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
+/**
+ * The take with the head's own motion drawn again (the lips and eyes do not change): with the next seed, or with the
+ * same seed after its scale changed (`nextSeed` false).
+ */
+export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal, nextSeed = true): Promise<Take> {
+  if (nextSeed) e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
   document.body.dataset.headSeed = String(e.headMotionSeed);
   const t0 = performance.now();
   const animation = await e.animate(t.samples, { unposed: true, signal });

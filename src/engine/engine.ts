@@ -32,6 +32,9 @@ export type { Animation, Frames, StageTimes } from './frames';
 export { StreamSession } from './stream';
 export { ModelLoadError } from '../model/artefacts';
 
+/** The largest headMotionScale: three times the fitted motion is already far livelier than any corpus speaker. */
+export const MAX_HEAD_MOTION_SCALE = 3;
+
 export interface EngineOptions extends ArtefactOptions {
   /**
    * 'auto' (default): WebGPU on a hardware adapter, else the CPU decoder. A software fallback adapter
@@ -50,6 +53,11 @@ export interface EngineOptions extends ArtefactOptions {
    * pose alone (a head that barely moves). Ignored for a model exported without it.
    */
   headMotionSeed?: number | null;
+  /**
+   * How far the head's own motion turns the head (default 1, as fitted: the corpus's typical speaker; 0.5 a calm
+   * one, 1.5 a lively one; 0 the mean pose alone). Speakers differ in this and their voices do not say it.
+   */
+  headMotionScale?: number;
 }
 
 export interface AnimateOptions {
@@ -113,7 +121,9 @@ export class TalkingFaceEngine {
     ]);
     const pipeline = new Pipeline(manifest, face, content, pose, decoder, head && new HeadMotion(head, m.d_model));
     if (options.headMotionSeed !== undefined) pipeline.headSeed = options.headMotionSeed;
-    return new TalkingFaceEngine(pipeline);
+    const engine = new TalkingFaceEngine(pipeline);
+    if (options.headMotionScale !== undefined) engine.headMotionScale = options.headMotionScale;
+    return engine;
   }
 
   get manifest(): Manifest {
@@ -166,6 +176,19 @@ export class TalkingFaceEngine {
   set headMotionSeed(seed: number | null) {
     if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
     this.pipeline.headSeed = seed;
+    this.rest = null;
+  }
+
+  /** How far the head's own motion turns the head in new animations and streams (1: as fitted). */
+  get headMotionScale(): number {
+    return this.pipeline.headScale;
+  }
+
+  set headMotionScale(scale: number) {
+    if (!Number.isFinite(scale) || scale < 0 || scale > MAX_HEAD_MOTION_SCALE) {
+      throw new RangeError(`headMotionScale must be a number from 0 to ${MAX_HEAD_MOTION_SCALE}, not ${scale}`);
+    }
+    this.pipeline.headScale = scale;
     this.rest = null;
   }
 

@@ -34,6 +34,8 @@ export class Pipeline {
   readonly templateMm: Float32Array;
   /** The seed of the head's own motion (new states draw with it); null: the pose head's mean pose alone. */
   headSeed: number | null = 0;
+  /** How far the head's own motion turns the head: 1 as fitted (the corpus's typical speaker), below calmer, above livelier. */
+  headScale = 1;
   private avatar: AvatarWeights | null = null;
   private closure: LipClosure | null | undefined;
 
@@ -148,7 +150,7 @@ export class Pipeline {
     if (this.headMotion && this.headSeed !== null) {
       state.head ??= this.headMotion.start(this.headSeed);
       const residual = this.headMotion.residuals(state.head, f0, poseToken, melIndex.length);
-      this.headMotion.compose(decoded.pose, residual, melIndex.length);
+      this.headMotion.compose(decoded.pose, residual, melIndex.length, this.headScale);
     }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;

@@ -117,11 +117,15 @@ export class HeadMotion {
     return out;
   }
 
-  /** Turn each pose (count x 6: rotation vector rad, translation mm) by its residual (degrees) about the pivot, in place. */
-  compose(pose: Float32Array, residualDeg: Float64Array, count: number): void {
+  /**
+   * Turn each pose (count x 6: rotation vector rad, translation mm) by its residual (degrees) about the pivot, in place;
+   * `scale` multiplies the residual (1: the motion as fitted; 0: the mean pose alone).
+   */
+  compose(pose: Float32Array, residualDeg: Float64Array, count: number, scale = 1): void {
     const p = this.params.pivotMm;
+    const k = DEG * scale;
     for (let f = 0; f < count; f++) {
-      const Rr = rotation(residualDeg[3 * f] * DEG, residualDeg[3 * f + 1] * DEG, residualDeg[3 * f + 2] * DEG);
+      const Rr = rotation(residualDeg[3 * f] * k, residualDeg[3 * f + 1] * k, residualDeg[3 * f + 2] * k);
       const R = mul(Rr, rotation(pose[6 * f], pose[6 * f + 1], pose[6 * f + 2]));
       const rv = rotationVector(R);
       const tx = pose[6 * f + 3] - p[0], ty = pose[6 * f + 4] - p[1], tz = pose[6 * f + 5] - p[2];

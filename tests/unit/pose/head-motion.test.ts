@@ -25,6 +25,19 @@ describe.skipIf(!manifest.head_motion)('the head\'s own motion', () => {
     expect(maxAbsDiff(pose, f32(fx, 'pose_sampled'))).toBeLessThan(1e-5);
   });
 
+  it('scales the residual it turns the poses by: 0 leaves the mean pose, 2 is the residual doubled', () => {
+    const residual = head.residuals(head.start(0), 0, poseToken, frames);
+    const mean = f32(fx, 'pose');
+    const still = mean.slice();
+    head.compose(still, residual, frames, 0);
+    expect(maxAbsDiff(still, mean)).toBeLessThan(1e-6);
+    const scaled = mean.slice(), doubled = mean.slice();
+    head.compose(scaled, residual, frames, 2);
+    head.compose(doubled, residual.map((x) => 2 * x), frames);
+    expect(maxAbsDiff(scaled, doubled)).toBeLessThan(1e-6);
+    expect(maxAbsDiff(scaled, mean)).toBeGreaterThan(0.01);
+  });
+
   it('in chunks equals whole, and another seed draws other motion', () => {
     const whole = head.residuals(head.start(7), 0, poseToken, frames);
     const state = head.start(7);
