@@ -5,14 +5,14 @@
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
  * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
- * avatar-head-bone, blendshapes. Methods: speak(audio), startMicrophone(), stop(). Events: ready, frame, ended, error
- * (detail.message is written for a person). Instances with the same model and backend share one engine.
+ * avatar-head-bone, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop().
+ * Events: ready, frame, ended, error (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
 import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import { frameWeights } from '../avatar/weights';
-import { TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
+import { MAX_HEAD_MOTION_SCALE, TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { openMicrophone } from '../audio/capture';
@@ -162,6 +162,7 @@ export class TalkingFaceElement extends HTMLElement {
       animation = await engine.animate(decoded.samples, {
         unposed: true,
         blendshapes: this.blendshapes,
+        headMotionScale: this.headMotionScale,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
       computeMs = performance.now() - t0;
@@ -205,7 +206,8 @@ export class TalkingFaceElement extends HTMLElement {
           detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs,
             ...(frames.blendshapes && frameWeights(frames.blendshapes, last)) },
         }));
-      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes });
+      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes,
+        headMotionScale: this.headMotionScale });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
       throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
@@ -248,6 +250,14 @@ export class TalkingFaceElement extends HTMLElement {
   /** Frames carry ARKit weights and visemes with an avatar, or when the page asks. */
   private get blendshapes(): boolean {
     return this.hasAttribute('avatar') || this.hasAttribute('blendshapes');
+  }
+
+  /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
+  private get headMotionScale(): number | undefined {
+    const v = this.getAttribute('head-motion')?.trim(), x = Number(v);
+    if (v && Number.isFinite(x) && x >= 0 && x <= MAX_HEAD_MOTION_SCALE) return x;
+    if (v) console.warn(`<talking-face> head-motion="${v}" is not a number from 0 to ${MAX_HEAD_MOTION_SCALE}; using the model's own motion (1)`);
+    return undefined;
   }
 
   private async afterLoad(): Promise<void> {

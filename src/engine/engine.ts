@@ -15,7 +15,7 @@ import { sessionsRequested, startOrt, type ExecutionProvider } from '../encoders
 import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
-import { HeadMotion, headMotionParams } from '../pose/head-motion';
+import { HeadMotion, checkedScale, headMotionParams } from '../pose/head-motion';
 import { detectWebGPU } from '../gpu/capabilities';
 import type { FaceTemplate } from '../template/face-template';
 import { DecoderBackends, type Backend } from './backends';
@@ -31,9 +31,7 @@ export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
 export { StreamSession } from './stream';
 export { ModelLoadError } from '../model/artefacts';
-
-/** The largest headMotionScale: three times the fitted motion is already far livelier than any corpus speaker. */
-export const MAX_HEAD_MOTION_SCALE = 3;
+export { MAX_HEAD_MOTION_SCALE } from '../pose/head-motion';
 
 export interface EngineOptions extends ArtefactOptions {
   /**
@@ -76,6 +74,8 @@ export interface AnimateOptions {
    * roll (Animation.blendshapes; src/avatar/, docs/avatar.md). Off by default: it costs a solve per frame.
    */
   blendshapes?: boolean;
+  /** How far the head's own motion turns the head in this animation (default: engine.headMotionScale). */
+  headMotionScale?: number;
   signal?: AbortSignal;
 }
 
@@ -185,10 +185,7 @@ export class TalkingFaceEngine {
   }
 
   set headMotionScale(scale: number) {
-    if (!Number.isFinite(scale) || scale < 0 || scale > MAX_HEAD_MOTION_SCALE) {
-      throw new RangeError(`headMotionScale must be a number from 0 to ${MAX_HEAD_MOTION_SCALE}, not ${scale}`);
-    }
-    this.pipeline.headScale = scale;
+    this.pipeline.headScale = checkedScale(scale)!;
     this.rest = null;
   }
 
@@ -224,7 +221,7 @@ export class TalkingFaceEngine {
     const blendshapes = options.blendshapes ? emptyBlendshapes(F) : undefined;
     const tongue = new Float32Array(F);
     const speech = new Float32Array(F);
-    const state = this.pipeline.newState({ blendshapes: options.blendshapes });
+    const state = this.pipeline.newState({ blendshapes: options.blendshapes, headMotionScale: checkedScale(options.headMotionScale) });
     for (let f0 = 0; f0 < F; f0 += chunk) {
       if (f0 > 0) await yieldToEventLoop(); // keep the page responsive through a long clip
       options.signal?.throwIfAborted();
@@ -261,13 +258,16 @@ export class TalkingFaceEngine {
    * Streaming: push audio as it arrives, get frames as soon as their look-ahead has arrived. `blendshapes`: the
    * frames also carry ARKit weights, visemes and head rotations (as animate's option).
    */
-  createStream(onFrames: (first: number, frames: Frames) => void, options: { maxLagFrames?: number; blendshapes?: boolean } = {}): StreamSession {
-    return new StreamSession(this.pipeline, onFrames, options.maxLagFrames, { blendshapes: options.blendshapes });
+  createStream(onFrames: (first: number, frames: Frames) => void,
+    options: { maxLagFrames?: number; blendshapes?: boolean; headMotionScale?: number } = {}): StreamSession {
+    return new StreamSession(this.pipeline, onFrames, options.maxLagFrames,
+      { blendshapes: options.blendshapes, headMotionScale: checkedScale(options.headMotionScale) });
   }
 
   /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
   listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
-    const stream = this.createStream(onFrames, { maxLagFrames: LiveSession.maxLag(options), blendshapes: options?.blendshapes });
+    const stream = this.createStream(onFrames,
+      { maxLagFrames: LiveSession.maxLag(options), blendshapes: options?.blendshapes, headMotionScale: options?.headMotionScale });
     return LiveSession.start(stream, media, options);
   }
 

@@ -17,6 +17,8 @@ export interface LiveOptions extends CaptureOptions {
   onError?: (error: Error) => void;
   /** Frames also carry ARKit weights, visemes and head rotations (Frames.blendshapes). */
   blendshapes?: boolean;
+  /** How far the head's own motion turns the head in this session (default: engine.headMotionScale). */
+  headMotionScale?: number;
 }
 
 export class LiveSession {

@@ -26,7 +26,14 @@ export const DEFAULT_CHUNK_FRAMES = 96;
  * What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last
  * residuals, and, when the frames carry ARKit weights, the solver's warm start.
  */
-export type ProducerState = PoseState & { head?: HeadMotionState; blendshapes?: SolverState };
+export type ProducerState = PoseState & { head?: HeadMotionState; headScale?: number; blendshapes?: SolverState };
+
+/** What a new state computes besides the face: `blendshapes` (the avatar stage), and its own head-motion scale. */
+export interface StateOptions {
+  blendshapes?: boolean;
+  /** Multiplies the head's own motion for this state's frames (default: the pipeline's headScale). */
+  headMotionScale?: number;
+}
 
 export class Pipeline {
   readonly times: StageTimes = { mel: 0, content: 0, hierarchical: 0, pose: 0, decoder: 0, posing: 0, blendshapes: 0 };
@@ -80,9 +87,10 @@ export class Pipeline {
   }
 
   /** `blendshapes`: the frames also carry ARKit weights, visemes and head rotations (the avatar stage). */
-  newState(options: { blendshapes?: boolean } = {}): ProducerState {
+  newState(options: StateOptions = {}): ProducerState {
     const state: ProducerState = this.pose.newState();
     if (options.blendshapes) state.blendshapes = this.avatarWeights.newState();
+    state.headScale = options.headMotionScale ?? this.headScale;
     return state;
   }
 
@@ -150,7 +158,7 @@ export class Pipeline {
     if (this.headMotion && this.headSeed !== null) {
       state.head ??= this.headMotion.start(this.headSeed);
       const residual = this.headMotion.residuals(state.head, f0, poseToken, melIndex.length);
-      this.headMotion.compose(decoded.pose, residual, melIndex.length, this.headScale);
+      this.headMotion.compose(decoded.pose, residual, melIndex.length, state.headScale ?? this.headScale);
     }
     const { vertices, unposed } = poseFrames(this.templateMm, decoded.offsets, decoded.pose, melIndex.length, this.mmPerUnit);
     this.times.posing += performance.now() - t;

@@ -4,7 +4,7 @@
  * the output equals the offline animation of the same audio. `lookAheadMs` is the audio a frame
  * waits for beyond its own time; processing time comes on top.
  */
-import { DEFAULT_CHUNK_FRAMES, type Pipeline, type ProducerState } from './pipeline';
+import { DEFAULT_CHUNK_FRAMES, type Pipeline, type ProducerState, type StateOptions } from './pipeline';
 import { yieldToEventLoop, type Frames } from './frames';
 
 export class StreamSession {
@@ -33,8 +33,8 @@ export class StreamSession {
      * output equals the offline animation.
      */
     private readonly maxLagFrames = Infinity,
-    /** `blendshapes`: the frames also carry ARKit weights, visemes and head rotations (Frames.blendshapes). */
-    options: { blendshapes?: boolean } = {},
+    /** `blendshapes`: the frames also carry ARKit weights, visemes and head rotations (Frames.blendshapes); `headMotionScale`. */
+    options: StateOptions = {},
   ) {
     this.state = pipeline.newState(options);
   }

@@ -60,6 +60,17 @@ function hash32(x: number): number {
   return x >>> 0;
 }
 
+/** The largest headMotionScale: three times the fitted motion is already far livelier than any corpus speaker. */
+export const MAX_HEAD_MOTION_SCALE = 3;
+
+/** A head-motion scale as given (undefined stays undefined: the engine's own), or a RangeError that says the range. */
+export function checkedScale(scale: number | undefined): number | undefined {
+  if (scale !== undefined && !(Number.isFinite(scale) && scale >= 0 && scale <= MAX_HEAD_MOTION_SCALE)) {
+    throw new RangeError(`headMotionScale must be a number from 0 to ${MAX_HEAD_MOTION_SCALE}, not ${scale}`);
+  }
+  return scale;
+}
+
 /** A standard normal draw for (seed, frame >= -2, axis): Box-Muller on two hashed uniforms. */
 export function headNormal(seed: number, frame: number, axis: number): number {
   const key = hash32(hash32((seed + 0x632be5ab) >>> 0) ^ hash32((frame + 2) * 8 + axis * 2 + 1));

@@ -4,7 +4,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import { f32, parseSafetensors } from '../../../src/model/safetensors';
-import { HeadMotion, headMotionParams, headNormal } from '../../../src/pose/head-motion';
+import { HeadMotion, checkedScale, headMotionParams, headNormal } from '../../../src/pose/head-motion';
 import { buf, loadFixtures, loadManifest, maxAbsDiff } from '../helpers/exported';
 
 const manifest = loadManifest();
@@ -77,5 +77,14 @@ describe('headNormal', () => {
     expect(Math.abs(mean)).toBeLessThan(0.03);
     expect(Math.abs(variance - 1)).toBeLessThan(0.04);
     expect(Math.abs(lag / z.length)).toBeLessThan(0.03);
+  });
+});
+
+describe('checkedScale', () => {
+  it('passes a head-motion scale from 0 to 3 (or none) and names the range otherwise', () => {
+    expect(checkedScale(undefined)).toBeUndefined();
+    expect(checkedScale(0)).toBe(0);
+    expect(checkedScale(1.5)).toBe(1.5);
+    for (const bad of [-0.1, 3.5, Number.NaN, Number.POSITIVE_INFINITY]) expect(() => checkedScale(bad)).toThrow(/from 0 to 3/);
   });
 });
