@@ -1,4 +1,6 @@
 """The speech front-end's speech set keeps the mesh corpus's test material out and labels every frame."""
+from contextlib import contextmanager
+
 import pytest
 
 from talkingface.corpus import kokoro
@@ -57,7 +59,6 @@ def test_the_accents_option_gives_kokoro_clips_an_accent_and_leaves_the_rest_of_
 
 
 def test_the_extrapolate_option_gives_kokoro_clips_a_voice_beyond_two_and_leaves_the_rest_of_the_plan(monkeypatch, tmp_path):
-    import numpy as np
     monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b", "am_c"])
     plain, beyond = speechset.plan(20, seed=3), speechset.plan(20, seed=3, extrapolate_share=0.5)
     changed = [(a, b) for a, b in zip(plain, beyond) if a != b]
@@ -69,29 +70,28 @@ def test_the_extrapolate_option_gives_kokoro_clips_a_voice_beyond_two_and_leaves
         name, w = first.split("*")
         assert speechset.EXTRAPOLATE[0] <= float(w) <= speechset.EXTRAPOLATE[1] and name != second
     # The style vector lies beyond the first voice, away from the second: w a + (1 - w) b.
-    (tmp_path / "voices").mkdir()
-    np.full((510, 256), 1.0, "<f4").tofile(tmp_path / "voices" / "af_a.bin")
-    np.full((510, 256), 3.0, "<f4").tofile(tmp_path / "voices" / "bm_b.bin")
-    monkeypatch.setattr(kokoro, "HOME", tmp_path)
-    kokoro._style_table.cache_clear()
-    try:
+    with _style_tables(monkeypatch, tmp_path, {"voices/af_a": 1.0, "voices/bm_b": 3.0}):
         assert kokoro.style("af_a*1.5+bm_b", 12)[0] == 1.5 * 1.0 - 0.5 * 3.0
-    finally:
-        kokoro._style_table.cache_clear()
 
 
 def test_an_accented_voice_reads_its_own_style_table(monkeypatch, tmp_path):
-    import numpy as np
-    (tmp_path / "voices").mkdir()
-    (tmp_path / "voices-accented").mkdir()
-    np.full((510, 256), 1.0, "<f4").tofile(tmp_path / "voices" / "af_a.bin")
-    np.full((510, 256), 3.0, "<f4").tofile(tmp_path / "voices-accented" / "ff_c.bin")
-    monkeypatch.setattr(kokoro, "HOME", tmp_path)
-    kokoro._style_table.cache_clear()
-    try:
+    with _style_tables(monkeypatch, tmp_path, {"voices/af_a": 1.0, "voices-accented/ff_c": 3.0}):
         assert kokoro.style("accented/ff_c", 12)[0] == 3.0 and kokoro.style("af_a", 12)[0] == 1.0
         assert kokoro.style("accented/ff_c*0.25+af_a", 12)[0] == 0.25 * 3.0 + 0.75 * 1.0
         assert kokoro.accented_voice_names() == ["accented/ff_c"]
+
+
+@contextmanager
+def _style_tables(monkeypatch, tmp_path, tables: dict):
+    """Kokoro's style tables as constant files ("folder/name" -> value) under tmp_path, read afresh inside."""
+    import numpy as np
+    for rel, value in tables.items():
+        (tmp_path / rel).parent.mkdir(exist_ok=True)
+        np.full((510, 256), value, "<f4").tofile(tmp_path / f"{rel}.bin")
+    monkeypatch.setattr(kokoro, "HOME", tmp_path)
+    kokoro._style_table.cache_clear()
+    try:
+        yield
     finally:
         kokoro._style_table.cache_clear()
 
