@@ -2,18 +2,12 @@
 import json
 
 import numpy as np
+import pytest
 import torch
 
-from talkingface.frontend import train as fe_train
+from talkingface.frontend import bank, train as fe_train
 from talkingface.phones import PHONE_INDEX
 from talkingface.train import train
-
-
-def test_warp_moves_energy_up_the_mel_axis():
-    mel = np.zeros((3, 80), np.float32)
-    mel[:, 20] = 1.0
-    assert np.argmax(fe_train.warp(mel, 1.1)[0]) == 22 and np.argmax(fe_train.warp(mel, 0.9)[0]) == 18
-    np.testing.assert_array_equal(fe_train.warp(mel, 1.0), mel)
 
 
 def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
@@ -57,6 +51,16 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     train.main(["--corpus", str(corpus.root), "--out", str(run2), "--steps", "1", "--batch-clips", "2", "--frames", "4",
                 "--frontend", str(wide / "frontend.pt")])
     assert train.load_checkpoint(run2 / "final.pt", corpus.template)[0].cfg.content_channels == 160
+    # the same speech packed into one file (frontend.bank) trains the same way, its measuring clips inside it
+    packed = tmp_path / "bank.npz"
+    bank.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(packed)])
+    with pytest.raises(SystemExit, match="leave out"):
+        fe_train.main(["--packed", str(packed), "--corpus", str(corpus.root), "--out", str(tmp_path / "x")])
+    from_pack = tmp_path / "fe-packed"
+    fe_train.main(["--packed", str(packed), "--out", str(from_pack), "--steps", "4", "--eval-every", "2", "--threads", "1",
+                   "--snapshots", "--consistency", "1"])
+    assert json.loads((from_pack / "frontend_eval.json").read_text())["step"] == 4
+    assert {p.name for p in from_pack.glob("frontend-step*.pt")} == {"frontend-step2.pt", "frontend-step4.pt"}
 
 
 def test_widening_keeps_the_function_and_the_new_channels_learn():
@@ -70,3 +74,15 @@ def test_widening_keeps_the_function_and_the_new_channels_learn():
     wide(mel).square().sum().backward()
     grown = wide.blocks[0].conv.weight.grad[32:]  # the weights into the new channels: zero, with a gradient
     assert wide.blocks[0].conv.weight[32:].abs().max() == 0 and grown.abs().max() > 0
+
+
+def test_view_disagreement_is_zero_for_the_same_posteriors_only():
+    a = torch.randn(3, 10, 40)
+    real = torch.ones(6, 10, dtype=torch.bool)
+    assert fe_train.view_disagreement(torch.cat([a, a]), real).abs() < 1e-6
+    other = fe_train.view_disagreement(torch.cat([a, torch.randn(3, 10, 40)]), real)
+    assert other > 0.1
+    real[:3, 5:] = False  # padded frames do not count
+    b = a.clone()
+    b[:, 5:] = torch.randn(3, 5, 40)
+    assert fe_train.view_disagreement(torch.cat([a, b]), real).abs() < 1e-6

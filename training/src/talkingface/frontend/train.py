@@ -22,19 +22,14 @@ import torch
 import torch.nn.functional as F
 
 from ..data.datasets import open_dataset
-from ..features import AudioConfig, warp_mel as warp
+from ..features import AudioConfig
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
 from ..phones import BILABIALS, PHONE_INDEX
 from ..train import articulation as art
 from ..train.data import prepare
 from ..train.train import load_frontend
-
-CROP = 300           # Mel frames per crop (3 s)
-WARP = (0.9, 1.1)    # frequency-axis warp factors (vocal-tract length perturbation)
-TIME_MASKS, TIME_MASK_MAX = 2, 12   # SpecAugment: masks per crop and their largest width (Mel frames)
-FREQ_MASKS, FREQ_MASK_MAX = 2, 10   # and along the Mel bands
-
+from .bank import Bank, PAD_LABEL, spec_augment, unpack, warp, warp_factors
 
 def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncoder:
     """`enc` with cfg.content_channels channels, computing the same function: every weight into a new channel is zero
@@ -74,34 +69,6 @@ def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
-def batch(clips, rng, size: int, stride: int) -> tuple[torch.Tensor, torch.Tensor]:
-    mels, labs = np.zeros((size, CROP, clips[0][0].shape[1]), np.float32), np.full((size, -(-CROP // stride)), -100, np.int64)
-    for b in range(size):
-        mel, lab = clips[rng.integers(len(clips))]
-        k0 = rng.integers(max(1, len(mel) - CROP + 1))
-        m = warp(mel[k0:k0 + CROP], rng.uniform(*WARP))
-        mels[b, : len(m)] = m
-        l = lab[k0:k0 + CROP:stride]
-        labs[b, : len(l)] = l
-    return torch.from_numpy(mels), torch.from_numpy(labs)
-
-
-def spec_augment(x: torch.Tensor, rng) -> torch.Tensor:
-    """Masks on the normalised features (0 = the mean), so the encoder cannot lean on any one band or instant."""
-    B, K, M = x.shape
-    x = x.clone()
-    for b in range(B):
-        for _ in range(TIME_MASKS):
-            w = rng.integers(TIME_MASK_MAX + 1)
-            t = rng.integers(max(1, K - w))
-            x[b, t:t + w] = 0
-        for _ in range(FREQ_MASKS):
-            w = rng.integers(FREQ_MASK_MAX + 1)
-            f = rng.integers(max(1, M - w))
-            x[b, :, f:f + w] = 0
-    return x
-
-
 def forward_augmented(enc: ContentEncoder, mel: torch.Tensor, rng) -> torch.Tensor:
     """The encoder's forward with SpecAugment between its normalisation and its convolutions."""
     x = spec_augment(enc.norm(mel), rng)
@@ -113,22 +80,56 @@ def forward_augmented(enc: ContentEncoder, mel: torch.Tensor, rng) -> torch.Tens
         enc.norm = identity
 
 
+def view_disagreement(logits: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
+    """Symmetric KL divergence between the posteriors of a batch's two views (its halves), over the frames that
+    are speech in both. logits (2B, K, D), real (2B, K) -> a scalar."""
+    a, b = logits.log_softmax(-1).chunk(2)
+    kl = (a.exp() * (a - b) + b.exp() * (b - a)).sum(-1) / 2                  # (B, K)
+    m = real.chunk(2)[0]
+    return (kl * m).sum() / m.sum().clamp(min=1)
+
+
 @torch.no_grad()
-def evaluate(enc: ContentEncoder, clips, num_classes: int, stride: int) -> dict:
+def evaluate(enc: ContentEncoder, clips: list[tuple[np.ndarray, np.ndarray]], num_classes: int, stride: int) -> dict:
+    """Frame accuracy, per-phone recall and /p b m/ heard over (mel, phones) clips."""
     enc.eval()
     tally = art.ContentTally(num_classes)
-    for c in clips:
-        tally.add(enc(torch.from_numpy(c.mel)[None])[0].numpy(), c.phones[::stride])
+    dev = next(enc.parameters()).device
+    for mel, phones in clips:
+        tally.add(enc(torch.from_numpy(mel)[None].to(dev))[0].cpu().numpy(), phones[::stride])
     enc.train()
     return tally.summary()
+
+
+def read_speech(args, audio: AudioConfig) -> tuple[list, dict]:
+    """-> training clips, {"val": clips, "test": clips}, each clip (log-Mel (K, n_mels), phone per frame (K,)),
+    from --packed or from --speech and --corpus."""
+    if args.packed:
+        if args.speech or args.corpus:
+            raise SystemExit("--packed holds the speech and the measuring clips: leave out --speech and --corpus")
+        parts = unpack(args.packed)
+        return parts["train"], {s: parts[s] for s in ("val", "test")}
+    if not (args.speech and args.corpus):
+        raise SystemExit("give --speech and --corpus (or --packed)")
+    clips = [c for folder in args.speech for c in load_speech(folder)]
+    ds = open_dataset(args.corpus)
+    prepared = lambda split: [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys(split))]
+    if not args.no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
+        clips += prepared("train")
+    return clips, {split: prepared(split) for split in ("val", "test")}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.train", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--speech", type=Path, nargs="+", required=True,
+    ap.add_argument("--speech", type=Path, nargs="+",
                     help="speech set folder(s) (talkingface.frontend.speechset; several seeds are several sets)")
-    ap.add_argument("--corpus", type=Path, required=True, help="mesh corpus whose val/test splits measure it")
+    ap.add_argument("--corpus", type=Path, help="mesh corpus whose val/test splits measure it")
+    ap.add_argument("--packed", type=Path, help="instead of --speech and --corpus: one file of frontend.bank's, "
+                    "the training speech and the measuring clips together (for a machine that holds neither)")
+    ap.add_argument("--device", default="cpu", help="torch device to train on (cpu, cuda); the front-end saved is the same")
+    ap.add_argument("--snapshots", action="store_true",
+                    help="also keep the front-end at every evaluation (OUT/frontend-step<N>.pt), to choose one on val")
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--minutes", type=float, default=30.0, help="training time budget (the cosine schedule spans it)")
     ap.add_argument("--steps", type=int, help="a step budget instead of --minutes (the same run on any machine)")
@@ -145,6 +146,10 @@ def main(argv=None) -> int:
     ap.add_argument("--channels", type=int, default=ModelConfig.content_channels,
                     help="the content encoder's width (default %(default)s); an --init front-end that is narrower is widened "
                          "to it, computing the same function at the start (widen)")
+    ap.add_argument("--consistency", type=float, default=0.0, metavar="WEIGHT",
+                    help="train on two views of each crop (two vocal-tract warps, two sets of masks) and add WEIGHT x the "
+                         "symmetric KL divergence between their posteriors: hearing a phone the same whatever the voice's "
+                         "length of tract, which unseen voices differ in (twice the work per step)")
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
@@ -155,19 +160,15 @@ def main(argv=None) -> int:
     log = lambda *a: print(*a, file=sys.stderr, flush=True)
 
     cfg, audio = ModelConfig(content_channels=args.channels), AudioConfig()
-    clips = [c for folder in args.speech for c in load_speech(folder)]
-    ds = open_dataset(args.corpus)
-    held = {split: [prepare(ds, k, audio) for k in ds.keys(split)] for split in ("val", "test")}
-    if not args.no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
-        clips += [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys("train"))]
-    log(f"front-end: {len(clips)} clips, {sum(len(m) for m, _ in clips) / audio.feature_rate / 60:.1f} min of speech; "
-        f"measured on {len(held['val'])} val / {len(held['test'])} test clips of {args.corpus}")
+    clips, held = read_speech(args, audio)
+    bank = Bank.from_clips(clips, args.device)
+    del clips
+    log(f"front-end: {len(bank.starts)} clips, {bank.minutes(audio.feature_rate):.1f} min of speech on {args.device}; "
+        f"measured on {len(held['val'])} val / {len(held['test'])} test clips of {args.packed or args.corpus}")
 
     enc = ContentEncoder(cfg, audio.n_mels)
-    allmel = np.concatenate([m for m, _ in clips])
-    enc.norm.mean.copy_(torch.from_numpy(allmel.mean(0)))
-    enc.norm.std.copy_(torch.from_numpy(allmel.std(0) + 1e-3))
-    del allmel
+    enc.norm.mean.copy_(bank.mel.mean(0).cpu())
+    enc.norm.std.copy_(bank.mel.std(0).cpu() + 1e-3)
     if args.init:
         init = load_frontend(args.init)
         arch = {k: cfg.to_dict()[k] for k in ("content_arch", "content_classes", "content_stride")}
@@ -180,7 +181,8 @@ def main(argv=None) -> int:
         enc = widen(narrow, cfg, args.seed) if init_cfg.content_channels < args.channels else narrow
         log(f"initialised from {args.init} ({init['step']} steps" +
             (f", widened from {init_cfg.content_channels} to {args.channels} channels)" if enc is not narrow else ")"))
-    class_weight = torch.ones(cfg.content_classes)
+    enc.to(args.device)
+    class_weight = torch.ones(cfg.content_classes, device=args.device)
     class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight
     opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)
     step, trained, history = 0, 0.0, []
@@ -188,14 +190,16 @@ def main(argv=None) -> int:
     if args.resume:
         ck = torch.load(ck_path, map_location="cpu", weights_only=False)
         enc.load_state_dict(ck["content"])
+        enc.to(args.device)
         opt.load_state_dict(ck["optimizer"])
         step, trained, history = ck["step"], ck["trained_seconds"], ck["history"]
         log(f"resumed at step {step} ({trained / 60:.1f} min)")
 
     def save(path: Path, final: bool = False) -> None:
-        payload = {"content": enc.state_dict(), "optimizer": opt.state_dict(), "step": step, "trained_seconds": trained,
-                   "history": history, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(), "args": vars(args) | {
-                       "speech": [str(f) for f in args.speech], "corpus": str(args.corpus), "out": str(args.out)}}
+        paths = {k: str(v) if v else None for k, v in (("corpus", args.corpus), ("packed", args.packed), ("out", args.out))}
+        payload = {"content": {k: v.cpu() for k, v in enc.state_dict().items()}, "optimizer": opt.state_dict(),
+                   "step": step, "trained_seconds": trained, "history": history, "model_config": cfg.to_dict(),
+                   "audio_config": audio.to_dict(), "args": vars(args) | paths | {"speech": [str(f) for f in args.speech or []]}}
         if final:
             payload.pop("optimizer")
         torch.save(payload, path.with_suffix(".tmp"))
@@ -210,10 +214,18 @@ def main(argv=None) -> int:
             break
         for g in opt.param_groups:  # cosine over the budget
             g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(progress(), 1.0))))
-        mel, lab = batch(clips, rng, args.batch, cfg.content_stride)
-        logits = forward_augmented(enc, mel, rng)
+        if args.consistency:
+            crop, lab = bank.crops(rng, args.batch, cfg.content_stride)
+            views = [warp(crop, warp_factors(rng, args.batch, crop.device)) for _ in range(2)]
+            logits = forward_augmented(enc, torch.cat(views), rng)
+            lab = torch.cat([lab, lab])
+        else:
+            mel, lab = bank.batch(rng, args.batch, cfg.content_stride)
+            logits = forward_augmented(enc, mel, rng)
         k = min(logits.shape[1], lab.shape[1])
-        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=-100)
+        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=PAD_LABEL)
+        if args.consistency:
+            loss = loss + args.consistency * view_disagreement(logits[:, :k], lab[:, :k] != PAD_LABEL)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
@@ -228,6 +240,8 @@ def main(argv=None) -> int:
                 f"test acc {100 * ev['test']['frame_accuracy']:.1f}%  /p b m/ heard {100 * ev['test']['bilabial_segments_heard']:.1f}%  "
                 f"{step / max(trained, 1e-9):.2f} steps/s  ~{trained * (1 / max(progress(), 1e-9) - 1) / 60:.1f} min left")
             save(ck_path)
+            if args.snapshots:
+                save(args.out / f"frontend-step{step}.pt", final=True)
     final = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
     save(ck_path)
     save(args.out / "frontend.pt", final=True)

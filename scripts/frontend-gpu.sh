@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Train speech front-ends on one GPU, several recipes side by side, from one packed speech bank.
+#
+#   scripts/frontend-gpu.sh BANK.npz OUT MINUTES
+#
+# BANK.npz is `python -m talkingface.frontend.bank`'s file (the training speech and the corpus's val and test clips),
+# so the machine needs neither the speech set nor the corpus: only this tree, PyTorch and numpy. A short run first
+# measures the speed (and fails in seconds where the setup is broken); then each recipe trains for MINUTES on batches
+# of 256 crops, with its front-end kept about six times on the way (--snapshots, to be chosen on val afterwards),
+# and is packed into OUT/<recipe>.tar with its log (the optimiser's checkpoint stays behind). A recipe still running
+# two minutes past its budget is stopped, its snapshots so far kept. Runs on the CPU too (slowly): DEVICE=cpu
+# (PYTHON names the interpreter: scripts/py's venv here, the machine's python3 by default).
+set -euo pipefail
+bank=$1 out=$2 minutes=$3
+device=${DEVICE:-cuda} python=${PYTHON:-python3}
+export PYTHONPATH=training/src${PYTHONPATH:+:$PYTHONPATH} PYTHONUNBUFFERED=1
+work=$(mktemp -d)
+mkdir -p "$out"
+
+train() {  # name, then frontend.train's options
+  local name=$1
+  shift
+  timeout "$(awk "BEGIN { print int($minutes * 60 + 120) }")" "$python" -m talkingface.frontend.train --packed "$bank" \
+    --out "$work/$name" --device "$device" --threads 2 --batch 256 --minutes "$minutes" --eval-every "$every" --snapshots \
+    "$@" >"$work/$name.log" 2>&1 || true
+  tar -C "$work" -cf "$out/$name.tar" --exclude checkpoint.pt "$name" "$name.log"
+}
+
+"$python" -m talkingface.frontend.train --packed "$bank" --out "$work/smoke" --device "$device" --threads 2 \
+  --batch 256 --steps 200 --eval-every 100 --consistency 1 2>&1 | tee "$work/smoke.log"
+rate=$(grep -o '[0-9.]* steps/s' "$work/smoke.log" | tail -n 1 | cut -d' ' -f1)
+every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 6 / 100) * 100; print (e < 100 ? 100 : e) }")
+echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
+
+train scratch --lr 2e-3 &
+train scratch-consistent --lr 2e-3 --consistency 1 &
+train tuned --lr 3e-4 --init models/checkpoint.pt &
+train tuned-consistent --lr 3e-4 --init models/checkpoint.pt --consistency 1 &
+wait
+for f in "$work"/*.log; do echo "== $f"; tail -n 4 "$f"; done
