@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
-# Train speech front-ends on one GPU, several recipes side by side, from one packed speech bank.
+# Train speech front-ends on one GPU, six recipes side by side (from scratch or from the shipped front-end, with and
+# without --consistency), from one packed speech bank.
 #
 #   scripts/frontend-gpu.sh BANK.npz OUT MINUTES
 #
 # BANK.npz is `python -m talkingface.frontend.bank`'s file (the training speech and the corpus's val and test clips),
 # so the machine needs neither the speech set nor the corpus: only this tree, PyTorch and numpy. A short run first
 # measures the speed (and fails in seconds where the setup is broken); then each recipe trains for MINUTES on batches
-# of 256 crops, with its front-end kept about six times on the way (--snapshots, to be chosen on val afterwards),
+# of 256 crops, with its front-end kept about five times on the way (--snapshots, to be chosen on val afterwards),
 # and is packed into OUT/<recipe>.tar with its log (the optimiser's checkpoint stays behind). A recipe still running
 # two minutes past its budget is stopped, its snapshots so far kept. Runs on the CPU too (slowly): DEVICE=cpu
 # (PYTHON names the interpreter: scripts/py's venv here, the machine's python3 by default).
@@ -29,12 +30,14 @@ train() {  # name, then frontend.train's options
 "$python" -m talkingface.frontend.train --packed "$bank" --out "$work/smoke" --device "$device" --threads 2 \
   --batch 256 --steps 200 --eval-every 100 --consistency 1 2>&1 | tee "$work/smoke.log"
 rate=$(grep -o '[0-9.]* steps/s' "$work/smoke.log" | tail -n 1 | cut -d' ' -f1)
-every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 6 / 100) * 100; print (e < 100 ? 100 : e) }")
+every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 5 / 100) * 100; print (e < 100 ? 100 : e) }")
 echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
 
 train scratch --lr 2e-3 &
 train scratch-consistent --lr 2e-3 --consistency 1 &
 train tuned --lr 3e-4 --init models/checkpoint.pt &
 train tuned-consistent --lr 3e-4 --init models/checkpoint.pt --consistency 1 &
+train scratch-consistent3 --lr 2e-3 --consistency 3 &
+train tuned-consistent3 --lr 3e-4 --init models/checkpoint.pt --consistency 3 &
 wait
 for f in "$work"/*.log; do echo "== $f"; tail -n 4 "$f"; done
