@@ -78,25 +78,24 @@ def warp(mel: torch.Tensor, factor: torch.Tensor) -> torch.Tensor:
     src = (torch.arange(M, device=mel.device)[None] / factor[:, None]).clamp(0, M - 1)   # (B, M)
     lo = src.floor().long()
     hi = (lo + 1).clamp(max=M - 1)
-    w = (src - lo)[:, None]                                                    # (B, 1, M)
-    take = lambda i: mel.gather(2, i[:, None].expand(B, K, M))
-    return take(lo) * (1 - w) + take(hi) * w
+    both = mel.gather(2, torch.cat([lo, hi], 1)[:, None].expand(B, K, 2 * M))  # (B, K, 2M): the bands below, above
+    return torch.lerp(both[..., :M], both[..., M:], (src - lo)[:, None])
 
 
 def spec_augment(x: torch.Tensor, rng: np.random.Generator) -> torch.Tensor:
     """Masks on the normalised features (0 = the mean), so the encoder cannot lean on any one band or instant:
     TIME_MASKS spans of up to TIME_MASK_MAX frames and FREQ_MASKS of up to FREQ_MASK_MAX bands, per crop."""
     B, K, M = x.shape
-    keep = torch.ones(B, K, M, dtype=torch.bool, device=x.device)
-    for axis, count, widest, n in ((1, TIME_MASKS, TIME_MASK_MAX, K), (2, FREQ_MASKS, FREQ_MASK_MAX, M)):
-        pos = torch.arange(n, device=x.device)[None]                           # (1, n)
+    keep = []
+    for count, widest, n in ((TIME_MASKS, TIME_MASK_MAX, K), (FREQ_MASKS, FREQ_MASK_MAX, M)):
+        pos, kept = torch.arange(n, device=x.device)[None], torch.ones(B, n, dtype=torch.bool, device=x.device)
         for _ in range(count):
             w = rng.integers(widest + 1, size=B)
             t = (rng.random(B) * np.maximum(1, n - w)).astype(np.int64)
             w, t = (torch.from_numpy(a).to(x.device)[:, None] for a in (w, t))
-            hit = (pos >= t) & (pos < t + w)                                   # (B, n)
-            keep &= hit.logical_not()[:, :, None] if axis == 1 else hit.logical_not()[:, None, :]
-    return x * keep
+            kept &= (pos < t) | (pos >= t + w)                                 # (B, n)
+        keep.append(kept.to(x.dtype))
+    return x * keep[0][:, :, None] * keep[1][:, None, :]
 
 
 def quantise(mel: np.ndarray, lo: float, hi: float) -> np.ndarray:
