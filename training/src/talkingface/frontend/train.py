@@ -105,8 +105,9 @@ def read_speech(args, audio: AudioConfig) -> tuple[list, dict]:
     """-> training clips, {"val": clips, "test": clips}, each clip (log-Mel (K, n_mels), phone per frame (K,)),
     from --packed or from --speech and --corpus."""
     if args.packed:
-        if args.speech or args.corpus:
-            raise SystemExit("--packed holds the speech and the measuring clips: leave out --speech and --corpus")
+        if args.speech or args.corpus or args.no_corpus_train:
+            raise SystemExit("--packed holds the speech and the measuring clips: leave out --speech, --corpus and "
+                             "--no-corpus-train (frontend.bank takes them)")
         parts = unpack(args.packed)
         return parts["train"], {s: parts[s] for s in ("val", "test")}
     if not (args.speech and args.corpus):
