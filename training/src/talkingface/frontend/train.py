@@ -7,6 +7,10 @@ frequency warping (vocal-tract length, 0.9-1.1) and SpecAugment-style masks. Eve
 measured on the mesh corpus's val and test splits, whose voices, sentences and recordings it never trains on.
 OUT/frontend.pt carries the encoder's weights (its Mel normalisation included), the model config, and the
 evaluation; `talkingface.train.train --frontend OUT/frontend.pt` puts it into the face model, frozen.
+
+On a machine with a GPU and neither the speech set nor the corpus, train from frontend.bank's packed file:
+
+  python -m talkingface.frontend.train --packed runs/bank.npz --device cuda --batch 256 --out runs/frontend --minutes 7
 """
 from __future__ import annotations
 
@@ -30,6 +34,7 @@ from ..train import articulation as art
 from ..train.data import prepare
 from ..train.train import load_frontend
 from .bank import Bank, PAD_LABEL, spec_augment, unpack, warp, warp_factors
+
 
 def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncoder:
     """`enc` with cfg.content_channels channels, computing the same function: every weight into a new channel is zero
