@@ -54,6 +54,9 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     # the same speech packed into one file (frontend.bank) trains the same way, its measuring clips inside it
     packed = tmp_path / "bank.npz"
     bank.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(packed)])
+    if not torch.cuda.is_available():
+        with pytest.raises(SystemExit, match="no CUDA device"):
+            fe_train.main(["--packed", str(packed), "--out", str(tmp_path / "x"), "--device", "cuda"])
     with pytest.raises(SystemExit, match="leave out"):
         fe_train.main(["--packed", str(packed), "--corpus", str(corpus.root), "--out", str(tmp_path / "x")])
     from_pack = tmp_path / "fe-packed"

@@ -159,6 +159,8 @@ def main(argv=None) -> int:
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
+    if args.device.startswith("cuda") and not torch.cuda.is_available():
+        raise SystemExit(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
     rng = np.random.default_rng(args.seed)
