@@ -27,6 +27,17 @@ export function fakeMicrophone(wav: string): { executablePath: string; args: str
   };
 }
 
+/**
+ * A page init script (page.addInitScript) under which WebGL names a GPU as its renderer: the views then draw with
+ * multisampling, as a visitor with a GPU sees them, where here (SwiftShader) they draw without (src/render/software-gl.ts).
+ */
+export function reportGpuRenderer(): void {
+  const getParameter = WebGL2RenderingContext.prototype.getParameter;
+  WebGL2RenderingContext.prototype.getParameter = function (this: WebGL2RenderingContext, p: GLenum) {
+    return p === 0x9246 ? 'ANGLE (NVIDIA, NVIDIA GeForce RTX 3060 Direct3D11 vs_5_0 ps_5_0, D3D11)' : getParameter.call(this, p); // UNMASKED_RENDERER_WEBGL
+  };
+}
+
 export default defineConfig({
   testDir: 'tests/e2e',
   timeout: 60_000,

@@ -7,7 +7,7 @@ import { chromium, type Browser, type Page } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
 import { mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { fakeMicrophone } from '../playwright.config';
+import { fakeMicrophone, reportGpuRenderer } from '../playwright.config';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const OUT = resolve(ROOT, 'docs/screenshots');
@@ -40,9 +40,16 @@ async function orbit(page: Page, azimuth: number, distance: number, aimY?: numbe
   await page.waitForTimeout(500);
 }
 
+/** A page of the given size whose views draw as on a GPU, multisampled (playwright.config.ts, reportGpuRenderer). */
+async function newPage(browser: Browser, width: number, height: number): Promise<Page> {
+  const page = await browser.newPage({ viewport: { width, height } });
+  await page.addInitScript(reportGpuRenderer);
+  return page;
+}
+
 /** The whole head: three angles at rest, idle, an open vowel and a closure on /m/ (a sample clip's frames). */
 async function headViews(browser: Browser): Promise<void> {
-  const page = await browser.newPage({ viewport: { width: 760, height: 980 } });
+  const page = await newPage(browser, 760, 980);
   await page.goto(`${URL_}/`);
   await ready(page, 'rest', 'shown');
   await page.waitForTimeout(1500);
@@ -107,7 +114,7 @@ async function main(): Promise<void> {
     const wav = resolve(ROOT, 'tests/fixtures/speech-kal.wav');
     const browser = await chromium.launch(fakeMicrophone(wav));
     await headViews(browser);
-    const page = await browser.newPage({ viewport: { width: 1100, height: 760 } });
+    const page = await newPage(browser, 1100, 760);
     await page.goto(`${URL_}/`);
     await ready(page, 'engine', 'ready');
     const sample = (await page.locator('#sample-select option').nth(1).getAttribute('value'))!;
@@ -135,7 +142,7 @@ async function main(): Promise<void> {
     await page.waitForTimeout(300);
     await page.screenshot({ path: resolve(OUT, 'vertex-attention.png') });
 
-    const live = await browser.newPage({ viewport: { width: 1100, height: 760 } });
+    const live = await newPage(browser, 1100, 760);
     await live.goto(`${URL_}/`);
     await ready(live, 'engine', 'ready');
     await live.locator('#record-button').click();
@@ -145,12 +152,12 @@ async function main(): Promise<void> {
     await live.locator('#record-button').click();
     await ready(live, 'take', 'ready');
 
-    const phone = await browser.newPage({ viewport: { width: 375, height: 740 } });
+    const phone = await newPage(browser, 375, 740);
     await phone.goto(`${URL_}/`);
     await ready(phone, 'engine', 'ready');
     await phone.screenshot({ path: resolve(OUT, 'phone.png'), fullPage: true });
 
-    const embed = await browser.newPage({ viewport: { width: 1000, height: 640 } });
+    const embed = await newPage(browser, 1000, 640);
     await embed.goto(`${URL_}/examples/embed.html`);
     await embed.waitForFunction(() => document.getElementById('log')?.textContent?.includes('ready'), null, { timeout: 120_000 });
     await embed.locator('#speak').click();

@@ -13,6 +13,7 @@ import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import { GltfAvatar } from './gltf-avatar';
 import { Blinks } from './blinks';
+import { softwareWebGL } from '../render/software-gl';
 
 /** About a head's bounding radius in metres (glTF's unit). */
 const HEAD_RADIUS = 0.15;
@@ -29,7 +30,7 @@ export class AvatarView {
   private blink = 0;
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGL(), alpha: false }); // render/software-gl.ts
     this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
     this.scene.background = new THREE.Color(0x1d2230);
     this.scene.add(avatar.gltf.scene);

@@ -20,6 +20,7 @@ import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
 import { pickFaceVertex, poseArrows } from './overlays';
+import { softwareWebGL } from './software-gl';
 
 export interface FaceViewOptions {
   /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
@@ -32,6 +33,8 @@ export interface FaceViewOptions {
    * on, and drawing them made the model ready 1.5 s later (npm run bench, first load).
    */
   lifePaused?: boolean;
+  /** Multisampled edges (default: on, unless WebGL is software here: software-gl.ts says why). */
+  antialias?: boolean;
 }
 
 /** Seconds for speech to blend in, and back out to the rest face. */
@@ -79,7 +82,7 @@ export class FaceView {
     readonly template: FaceTemplate,
     options: FaceViewOptions = {},
   ) {
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: true, alpha: false });
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: options.antialias ?? !softwareWebGL(), alpha: false });
     this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
     this.model = new Head(template);
     shareTongueProgram(this.model);

@@ -1,4 +1,5 @@
 import { test, expect, imageStats } from './fixtures';
+import { reportGpuRenderer } from '../../playwright.config';
 
 test.describe('the face viewer', () => {
   test.beforeEach(async ({ page }) => {
@@ -20,6 +21,17 @@ test.describe('the face viewer', () => {
     expect(Math.abs(cx - 0.5)).toBeLessThan(0.15);
     expect(Math.abs(cy - 0.5)).toBeLessThan(0.15);
     await test.info().attach('viewer.png', { body: shot, contentType: 'image/png' });
+  });
+
+  test('draws without multisampling where WebGL is software, with it where the renderer is a GPU', async ({ page }) => {
+    // Here WebGL is SwiftShader: the canvas's context was made without antialias (src/render/software-gl.ts).
+    const antialias = () => document.querySelector<HTMLCanvasElement>('#face-canvas')!.getContext('webgl2')!.getContextAttributes()!.antialias;
+    expect(await page.evaluate(antialias)).toBe(false);
+    // The same page where the browser names a GPU as its renderer: multisampled, as before.
+    await page.addInitScript(reportGpuRenderer);
+    await page.reload();
+    await expect(page.locator('body')).toHaveAttribute('data-ready', 'true');
+    expect(await page.evaluate(antialias)).toBe(true);
   });
 
   test('finds the WebGPU adapter and says so in the details', async ({ page }) => {
