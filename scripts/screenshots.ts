@@ -141,6 +141,7 @@ async function main(): Promise<void> {
     await ready(page, 'painted', 'vertex-attention');
     await page.waitForTimeout(300);
     await page.screenshot({ path: resolve(OUT, 'vertex-attention.png') });
+    await page.close(); // each page closed once taken: every open page redraws its idle face on the same CPU
 
     const live = await newPage(browser, 1100, 760);
     await live.goto(`${URL_}/`);
@@ -151,11 +152,13 @@ async function main(): Promise<void> {
     await live.screenshot({ path: resolve(OUT, 'recording.png') });
     await live.locator('#record-button').click();
     await ready(live, 'take', 'ready');
+    await live.close();
 
     const phone = await newPage(browser, 375, 740);
     await phone.goto(`${URL_}/`);
     await ready(phone, 'engine', 'ready');
     await phone.screenshot({ path: resolve(OUT, 'phone.png'), fullPage: true });
+    await phone.close();
 
     const embed = await newPage(browser, 1000, 640);
     await embed.goto(`${URL_}/examples/embed.html`);
