@@ -1,9 +1,9 @@
 /**
  * Whether this page's WebGL draws in software (SwiftShader, llvmpipe, WARP): a computer without a usable GPU, where
  * every pixel is drawn by the CPU that the model's sessions start on. There the views draw without multisampling:
- * under SwiftShader the demo was ready about a sixth sooner without it (2.42 against 2.90 s, medians of four
- * alternating pairs of `npm run bench -- --first-load-only`), and the face shown sooner too. On a GPU, multisampling
- * costs next to nothing and the edges stay smooth.
+ * under SwiftShader the demo was ready sooner without it in six alternating pairs of `npm run bench --
+ * --first-load-only` (medians 2.45 against 2.90 s; README, First load), and the face shown sooner too. On a GPU,
+ * multisampling costs next to nothing and the edges stay smooth.
  */
 
 /** Renderer names of software rasterisers, as WEBGL_debug_renderer_info gives them (ANGLE wraps them in its own). */

@@ -6,7 +6,7 @@ All clips' log-Mel frames are concatenated into one (frames, n_mels) array with 
 of crops is one gather, and the vocal-tract warp and SpecAugment's masks are tensor operations: a GPU trains from it
 at full speed, the CPU as before. `pack` writes the bank (and the mesh corpus's val and test clips, which measure the
 front-end) to one compressed file, the Mel quantised to 8 bits, so that a training run can go to a machine that holds
-neither the speech set nor the corpus (a GPU's, where what travels is small: about 0.3 MB per minute of speech).
+neither the speech set nor the corpus (a GPU's, where what travels is small: about 0.15 MiB per minute of speech).
 """
 from __future__ import annotations
 
@@ -40,10 +40,6 @@ class Bank:
         t = lambda a, dtype: torch.from_numpy(np.ascontiguousarray(a)).to(device=device, dtype=dtype)
         return cls(t(np.concatenate([m for m, _ in clips]), torch.float32),
                    t(np.concatenate([l for _, l in clips]), torch.int64), t(starts, torch.int64), t(lengths, torch.int64))
-
-    def clips(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        mel, lab = self.mel.cpu().numpy(), self.labels.cpu().numpy()
-        return [(mel[s:s + n], lab[s:s + n]) for s, n in zip(self.starts.tolist(), self.lengths.tolist())]
 
     def minutes(self, rate: float) -> float:
         return len(self.mel) / rate / 60
@@ -133,10 +129,8 @@ def unpack(path: Path) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
 
 
 def main(argv=None) -> int:
-    from ..data.datasets import open_dataset
     from ..features import AudioConfig
-    from ..train.data import prepare
-    from .train import load_speech
+    from .train import read_speech
 
     ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.bank", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -145,12 +139,9 @@ def main(argv=None) -> int:
     ap.add_argument("--no-corpus-train", action="store_true", help="leave out the mesh corpus's train split")
     ap.add_argument("--out", type=Path, required=True, help="the packed file (.npz); frontend.train --packed reads it")
     args = ap.parse_args(argv)
-    audio, ds = AudioConfig(), open_dataset(args.corpus)
-    clip = lambda k: (lambda c: (c.mel, c.phones))(prepare(ds, k, audio))
-    train = [c for folder in args.speech for c in load_speech(folder)]
-    if not args.no_corpus_train:
-        train += [clip(k) for k in ds.keys("train")]
-    counts = pack(args.out, train, {s: [clip(k) for k in ds.keys(s)] for s in ("val", "test")})
+    audio = AudioConfig()
+    train, held = read_speech(args.speech, args.corpus, args.no_corpus_train, audio)
+    counts = pack(args.out, train, held)
     print(f"packed {counts} clips, {sum(len(m) for m, _ in train) / audio.feature_rate / 60:.1f} min of training speech, "
           f"{args.out.stat().st_size / 2**20:.1f} MiB -> {args.out}", file=sys.stderr)
     return 0

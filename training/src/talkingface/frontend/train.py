@@ -106,9 +106,19 @@ def evaluate(enc: ContentEncoder, clips: list[tuple[np.ndarray, np.ndarray]], nu
     return tally.summary()
 
 
-def read_speech(args, audio: AudioConfig) -> tuple[list, dict]:
-    """-> training clips, {"val": clips, "test": clips}, each clip (log-Mel (K, n_mels), phone per frame (K,)),
-    from --packed or from --speech and --corpus."""
+def read_speech(speech: list[Path], corpus: Path, no_corpus_train: bool, audio: AudioConfig) -> tuple[list, dict]:
+    """-> training clips (the speech sets', and the corpus's train split unless no_corpus_train), and the corpus's
+    {"val": clips, "test": clips}; each clip (log-Mel (K, n_mels), phone per Mel frame (K,))."""
+    clips = [c for folder in speech for c in load_speech(folder)]
+    ds = open_dataset(corpus)
+    prepared = lambda split: [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys(split))]
+    if not no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
+        clips += prepared("train")
+    return clips, {split: prepared(split) for split in ("val", "test")}
+
+
+def read_args_speech(args, audio: AudioConfig) -> tuple[list, dict]:
+    """read_speech's clips from --packed, or from --speech and --corpus."""
     if args.packed:
         if args.speech or args.corpus or args.no_corpus_train:
             raise SystemExit("--packed holds the speech and the measuring clips: leave out --speech, --corpus and "
@@ -117,12 +127,7 @@ def read_speech(args, audio: AudioConfig) -> tuple[list, dict]:
         return parts["train"], {s: parts[s] for s in ("val", "test")}
     if not (args.speech and args.corpus):
         raise SystemExit("give --speech and --corpus (or --packed)")
-    clips = [c for folder in args.speech for c in load_speech(folder)]
-    ds = open_dataset(args.corpus)
-    prepared = lambda split: [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys(split))]
-    if not args.no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
-        clips += prepared("train")
-    return clips, {split: prepared(split) for split in ("val", "test")}
+    return read_speech(args.speech, args.corpus, args.no_corpus_train, audio)
 
 
 def main(argv=None) -> int:
@@ -168,7 +173,7 @@ def main(argv=None) -> int:
     log = lambda *a: print(*a, file=sys.stderr, flush=True)
 
     cfg, audio = ModelConfig(content_channels=args.channels), AudioConfig()
-    clips, held = read_speech(args, audio)
+    clips, held = read_args_speech(args, audio)
     bank = Bank.from_clips(clips, args.device)
     del clips
     log(f"front-end: {len(bank.starts)} clips, {bank.minutes(audio.feature_rate):.1f} min of speech on {args.device}; "
