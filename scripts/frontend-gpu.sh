@@ -2,7 +2,7 @@
 # Train speech front-ends on one GPU, six recipes side by side (from scratch or from the shipped front-end, with and
 # without --consistency), from one packed speech bank.
 #
-#   scripts/frontend-gpu.sh BANK.npz OUT MINUTES
+#   scripts/frontend-gpu.sh BANK.npz OUT MINUTES [RECIPES]
 #
 # BANK.npz is `python -m talkingface.frontend.bank`'s file (the training speech and the corpus's val and test clips),
 # so the machine needs neither the speech set nor the corpus: only this tree, PyTorch and numpy. A short run first
@@ -11,8 +11,10 @@
 # and is packed into OUT/<recipe>.tar with its log (the optimiser's checkpoint stays behind). A recipe still running
 # two minutes past its budget is stopped, its snapshots so far kept. Runs on the CPU too (slowly): DEVICE=cpu
 # (PYTHON names the interpreter: scripts/py's venv here, the machine's python3 by default).
+# RECIPES, where given, is a file of recipes, one a line: a name, then frontend.train's options (# starts a comment);
+# scripts/frontend-gpu-timbre.txt is the second run's. Without it, the first run's six below.
 set -euo pipefail
-bank=$1 out=$2 minutes=$3
+bank=$1 out=$2 minutes=$3 recipes=${4:-}
 device=${DEVICE:-cuda} python=${PYTHON:-python3}
 export PYTHONPATH=training/src${PYTHONPATH:+:$PYTHONPATH} PYTHONUNBUFFERED=1
 work=$(mktemp -d)
@@ -33,11 +35,19 @@ rate=$(grep -o '[0-9.]* steps/s' "$work/smoke.log" | tail -n 1 | cut -d' ' -f1)
 every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 5 / 100) * 100; print (e < 100 ? 100 : e) }")
 echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
 
-train scratch --lr 2e-3 &
-train scratch-consistent --lr 2e-3 --consistency 1 &
-train tuned --lr 3e-4 --init models/checkpoint.pt &
-train tuned-consistent --lr 3e-4 --init models/checkpoint.pt --consistency 1 &
-train scratch-consistent3 --lr 2e-3 --consistency 3 &
-train tuned-consistent3 --lr 3e-4 --init models/checkpoint.pt --consistency 3 &
+if [[ -n $recipes ]]; then
+  while read -r name options; do
+    [[ -z $name || $name == \#* ]] && continue
+    # shellcheck disable=SC2086  # the options are words
+    train "$name" $options &
+  done <"$recipes"
+else
+  train scratch --lr 2e-3 &
+  train scratch-consistent --lr 2e-3 --consistency 1 &
+  train tuned --lr 3e-4 --init models/checkpoint.pt &
+  train tuned-consistent --lr 3e-4 --init models/checkpoint.pt --consistency 1 &
+  train scratch-consistent3 --lr 2e-3 --consistency 3 &
+  train tuned-consistent3 --lr 3e-4 --init models/checkpoint.pt --consistency 3 &
+fi
 wait
 for f in "$work"/*.log; do echo "== $f"; tail -n 4 "$f"; done

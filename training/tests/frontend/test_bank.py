@@ -53,6 +53,22 @@ def test_spec_augment_masks_spans_of_frames_and_bands():
     assert (zero == (frames[:, :, None] | bands[:, None, :])).all()  # nothing else masked
 
 
+def test_timbre_changes_the_chosen_crops_smoothly_across_bands():
+    rng = np.random.default_rng(7)
+    mel = torch.from_numpy(np.abs(rng.normal(1, 1, (64, 50, 80))).astype(np.float32))
+    state = np.random.default_rng(8)
+    assert fb.timbre(mel, state, 0.0) is mel
+    assert state.random() == np.random.default_rng(8).random()  # off draws nothing: other runs keep their stream
+    out = fb.timbre(mel, np.random.default_rng(9), 0.5)
+    changed = (out != mel).flatten(1).any(1)
+    assert 20 <= int(changed.sum()) <= 44  # about half the crops, the rest untouched
+    assert (out >= 0).all() and torch.isfinite(out).all()  # still log(energy + 1)
+    # Across bands the changed crops are smoother (the lifter) and their band means moved (the gain).
+    rough = lambda x: (x[..., 1:] - x[..., :-1]).abs().mean((1, 2))
+    assert (rough(out[changed]) < rough(mel[changed])).all()
+    assert ((out[changed] - mel[changed]).mean(1).abs().amax(1) > 0.05).all()
+
+
 def test_pack_round_trip(tmp_path):
     rng = np.random.default_rng(4)
     train, val = toy_clips(rng), toy_clips(rng, (30, 40))

@@ -61,7 +61,7 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
         fe_train.main(["--packed", str(packed), "--corpus", str(corpus.root), "--out", str(tmp_path / "x")])
     from_pack = tmp_path / "fe-packed"
     fe_train.main(["--packed", str(packed), "--out", str(from_pack), "--steps", "4", "--eval-every", "2", "--threads", "1",
-                   "--snapshots", "--consistency", "1"])
+                   "--snapshots", "--consistency", "1", "--timbre", "0.5"])
     assert json.loads((from_pack / "frontend_eval.json").read_text())["step"] == 4
     assert {p.name for p in from_pack.glob("frontend-step*.pt")} == {"frontend-step2.pt", "frontend-step4.pt"}
 

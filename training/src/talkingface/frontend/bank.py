@@ -23,6 +23,9 @@ WARP = (0.9, 1.1)    # frequency-axis warp factors (vocal-tract length perturbat
 TIME_MASKS, TIME_MASK_MAX = 2, 12   # SpecAugment: masks per crop and their largest width (Mel frames)
 FREQ_MASKS, FREQ_MASK_MAX = 2, 10   # and along the Mel bands
 PAD_LABEL = -100     # cross-entropy's ignore_index: frames past a clip's end
+TIMBRE_GAIN = 0.7    # timbre: the largest weight (natural log of energy) of each of the smooth gain's cosines
+TIMBRE_COSINES = 3   # ... and how many (orders 1, 2, 3 over the Mel axis)
+TIMBRE_LIFTER = (12, 30)  # cepstral coefficients kept of the 80 where the fine structure across bands is smoothed
 
 
 @dataclass
@@ -92,6 +95,34 @@ def spec_augment(x: torch.Tensor, rng: np.random.Generator) -> torch.Tensor:
             kept &= (pos < t) | (pos >= t + w)                                 # (B, n)
         keep.append(kept.to(x.dtype))
     return x * keep[0][:, :, None] * keep[1][:, None, :]
+
+
+def timbre(mel: torch.Tensor, rng: np.random.Generator, p: float) -> torch.Tensor:
+    """A voice of another timbre, for a fraction `p` of the crops: (1) a smooth random gain along the Mel axis
+    (TIMBRE_COSINES cosines of random weight and phase, applied to the energy: a spectral tilt and broad formant
+    bumps that no microphone or vocal-tract warp gives) and (2) the fine structure across bands (harmonics of the
+    voice's pitch, a synthesiser's artefacts) smoothed by a cepstral lifter, partly (mixed in by a random weight).
+    The features are log(energy + 1) (features.log_mel), so the gain acts on exp(x) - 1. (B, K, M) -> same."""
+    if p <= 0:  # (drawing nothing: runs without it keep their random stream)
+        return mel
+    B, K, M = mel.shape
+    dev = mel.device
+    chosen = torch.from_numpy(rng.random(B) < p).to(dev)
+    m = (torch.arange(M, device=dev, dtype=torch.float32) + 0.5) / M                      # (M,)
+    order = torch.arange(1, TIMBRE_COSINES + 1, device=dev, dtype=torch.float32)
+    weight = torch.from_numpy(rng.uniform(-TIMBRE_GAIN, TIMBRE_GAIN, (B, TIMBRE_COSINES))).to(dev, torch.float32)
+    phase = torch.from_numpy(rng.uniform(0, 2 * np.pi, (B, TIMBRE_COSINES))).to(dev, torch.float32)
+    gain = (weight[:, :, None] * torch.cos(np.pi * order[None, :, None] * m[None, None] + phase[:, :, None])).sum(1)  # (B, M)
+    x = torch.log1p(torch.expm1(mel) * gain.exp()[:, None])
+    # An orthonormal DCT-II across the bands; the coefficients past each crop's lifter are dropped.
+    k = torch.arange(M, device=dev, dtype=torch.float32)
+    dct = torch.cos(np.pi * k[:, None] * m[None]) * torch.where(k == 0, 1 / np.sqrt(M), np.sqrt(2 / M))[:, None]  # (M coef, M band)
+    kept = torch.from_numpy(rng.integers(TIMBRE_LIFTER[0], TIMBRE_LIFTER[1] + 1, B)).to(dev)
+    lifter = (k[None] < kept[:, None]).to(mel.dtype)                                       # (B, M coef)
+    smooth = ((x @ dct.T) * lifter[:, None]) @ dct
+    mix = torch.from_numpy(rng.random(B)).to(dev, torch.float32)[:, None, None]
+    x = torch.lerp(x, smooth, mix).clamp(min=0)
+    return torch.where(chosen[:, None, None], x, mel)
 
 
 def quantise(mel: np.ndarray, lo: float, hi: float) -> np.ndarray:

@@ -33,7 +33,7 @@ from ..phones import BILABIALS, PHONE_INDEX
 from ..train import articulation as art
 from ..train.data import prepare
 from ..train.train import load_frontend
-from .bank import Bank, PAD_LABEL, spec_augment, unpack, warp, warp_factors
+from .bank import Bank, PAD_LABEL, spec_augment, timbre, unpack, warp, warp_factors
 
 
 def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncoder:
@@ -161,6 +161,9 @@ def main(argv=None) -> int:
                     help="train on two views of each crop (two vocal-tract warps, two sets of masks) and add WEIGHT x the "
                          "symmetric KL divergence between their posteriors: hearing a phone the same whatever the voice's "
                          "length of tract, which unseen voices differ in (twice the work per step)")
+    ap.add_argument("--timbre", type=float, default=0.0, metavar="FRACTION",
+                    help="give this fraction of the crops another timbre (bank.timbre: a smooth random gain along the Mel "
+                         "axis, the fine structure across bands partly smoothed); with --consistency each view its own")
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
@@ -229,11 +232,12 @@ def main(argv=None) -> int:
             g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(progress(), 1.0))))
         if args.consistency:
             crop, lab = bank.crops(rng, args.batch, cfg.content_stride)
-            views = [warp(crop, warp_factors(rng, args.batch, crop.device)) for _ in range(2)]
+            views = [timbre(warp(crop, warp_factors(rng, args.batch, crop.device)), rng, args.timbre) for _ in range(2)]
             logits = forward_augmented(enc, torch.cat(views), rng)
             lab = torch.cat([lab, lab])
         else:
             mel, lab = bank.batch(rng, args.batch, cfg.content_stride)
+            mel = timbre(mel, rng, args.timbre)
             logits = forward_augmented(enc, mel, rng)
         k = min(logits.shape[1], lab.shape[1])
         loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=PAD_LABEL)
