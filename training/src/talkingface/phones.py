@@ -22,6 +22,19 @@ VOWELS = frozenset("AA AE AH AO AW AY EH ER EY IH IY OW OY UH UW".split())
 OPEN_VOWELS = frozenset(("AA", "AE", "AH", "AO", "AW", "AY"))
 BILABIALS = frozenset(("P", "B", "M"))
 LABIODENTALS = frozenset(("F", "V"))
+# What a viewer sees of each phone at the lips (the groups of viseme sets such as Oculus's): a front-end that takes
+# one phone for another of its group costs the face little, one that takes it for another group shows.
+LIP_GROUPS = {
+    "closed": ("P", "B", "M"),
+    "lip on teeth": ("F", "V"),
+    "tongue between teeth": ("TH", "DH"),
+    "rounded": ("W", "UW", "UH", "OW", "OY", "AO", "R", "ER", "SH", "ZH", "CH", "JH"),
+    "open": ("AA", "AE", "AH", "AW", "AY"),
+    "spread": ("IY", "IH", "EY", "EH", "Y"),
+    "lips at rest": ("T", "D", "N", "L", "S", "Z", "K", "G", "NG", "HH"),
+    "silence": (SILENCE,),
+}
+LIP_GROUP_OF = {p: g for g, phones in LIP_GROUPS.items() for p in phones}
 
 # Phone names used by festival (radio phoneset) and flite (cmu_us) that differ from ARPAbet.
 _ALIASES = {

@@ -32,3 +32,45 @@ def test_warps_average_the_log_posteriors_of_warped_mels(trained_run):
         torch.testing.assert_close(measure.heard(enc, mel, (0.9, 1.1)), (lp[0] + lp[1]) / 2)
     with pytest.raises(SystemExit):
         measure.main([str(trained_run / "final.pt"), "--corpus", "x", "--warps", "1,three"])
+
+
+def test_a_chosen_warp_is_the_most_certain_or_the_best_scoring_one(trained_run):
+    import numpy as np
+    import pytest
+    import torch
+    from talkingface.features import warp_mel
+    enc, _ = measure.load_encoder(str(trained_run / "final.pt"))
+    mel = np.random.default_rng(1).standard_normal((90, 80)).astype(np.float32) + 4
+    warps = (0.9, 1.0, 1.1)
+    with torch.no_grad():
+        lps = [enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]
+    certainty = [float((lp.exp() * lp).sum(-1).mean()) for lp in lps]
+    lp, w = measure.heard_at_chosen_warp(enc, mel, warps, "entropy", np.zeros(len(lps[0]), np.int64))
+    assert w == warps[int(np.argmax(certainty))] and torch.equal(lp, lps[warps.index(w)])
+    # oracle: labels that are what the 1.1 warp hears make it the best
+    labels = lps[2].argmax(-1).numpy()
+    assert measure.heard_at_chosen_warp(enc, mel, warps, "oracle", labels)[1] == 1.1
+    with pytest.raises(ValueError, match="entropy"):
+        measure.heard_at_chosen_warp(enc, mel, warps, "loudest", labels)
+    with pytest.raises(SystemExit):
+        measure.main([str(trained_run / "final.pt"), "--corpus", "x", "--choose-warp", "entropy"])  # one warp only
+
+
+def test_accuracy_by_kind_reads_the_confusion():
+    import numpy as np
+    from talkingface.phones import PHONE_INDEX, PHONES
+    from talkingface.train.articulation import accuracy_by_kind
+    conf = np.zeros((len(PHONES) + 1, len(PHONES) + 1), np.int64)
+    P, B, T, AA, AE, IY, SIL = (PHONE_INDEX[p] for p in ("P", "B", "T", "AA", "AE", "IY", "SIL"))
+    conf[P, P] = 3   # right
+    conf[P, B] = 1   # wrong phone, same lip group (closed)
+    conf[T, P] = 2   # wrong group
+    conf[T, T] = 2
+    conf[AA, AE] = 4  # wrong vowel, same group (open)
+    conf[IY, IY] = 4
+    conf[AA, len(PHONES)] = 2  # the blank: no group
+    conf[SIL, SIL] = 100  # silence counts in neither
+    r = accuracy_by_kind(conf)
+    assert r["consonant_frame_accuracy"] == 5 / 8
+    assert r["vowel_frame_accuracy"] == 4 / 10
+    assert r["lip_group_accuracy"] == (3 + 1 + 2 + 4 + 4) / 18

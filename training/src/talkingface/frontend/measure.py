@@ -1,6 +1,13 @@
 """Measure speech front-ends by themselves, side by side: frame accuracy, /p b m/ heard, and both per voice.
 
   scripts/py -m talkingface.frontend.measure --corpus data/corpus [--split val,test] [--warps 0.92,1,1.08] FRONTEND [FRONTEND ...] [--out F.json]
+  scripts/py -m talkingface.frontend.measure --corpus data/corpus --warps 0.86,0.9,0.94,0.97,1,1.03,1.06,1.1,1.14 --choose-warp entropy FRONTEND
+
+Per voice it also says where the frames are lost: vowels, consonants, and how many speech frames were heard as a
+phone of the right lip group (phones.LIP_GROUPS: what a viewer would see). With --choose-warp, each clip is heard
+through one of the --warps instead of their average: the one whose posteriors are the most certain (entropy: what
+a page could do, vocal-tract length normalisation without labels) or the one that scores best against the
+alignment (oracle: a bound, not a method; how far a better guess of the voice's tract length could go).
 
 Each FRONTEND is a front-end file (frontend.train's frontend.pt) or a face checkpoint, whose content encoder is read
 (models/checkpoint.pt: the shipped one). The numbers are those of `talkingface.train.evaluate`'s content encoder
@@ -44,14 +51,44 @@ def heard(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...] = (1.0,
     return torch.stack([enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]).mean(0)
 
 
-def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ...] = (1.0,)) -> dict:
-    """Over prepared clips: content_summary's figures for all of them, and voice_rows per voice."""
+@torch.no_grad()
+def heard_at_chosen_warp(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...], how: str,
+                         labels: np.ndarray) -> tuple[torch.Tensor, float]:
+    """The clip heard through the one of `warps` that `how` picks: "entropy", the lowest mean entropy of the
+    posteriors over the clip's frames; "oracle", the highest frame accuracy against `labels` (the content frames'
+    phones). -> ((Kc, D) log-posteriors, the warp)."""
+    lps = [enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]
+    if how == "entropy":
+        score = [float((lp.exp() * lp).sum(-1).mean()) for lp in lps]  # minus the entropy: higher is more certain
+    elif how == "oracle":
+        k = min(len(labels), len(lps[0]))
+        score = [float((lp[:k].argmax(-1).numpy() == labels[:k]).mean()) for lp in lps]
+    else:
+        raise ValueError(f"choose a warp by 'entropy' or 'oracle', not {how!r}")
+    best = int(np.argmax(score))
+    return lps[best], warps[best]
+
+
+def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ...] = (1.0,), choose: str | None = None) -> dict:
+    """Over prepared clips: content_summary's figures for all of them, and voice_rows per voice; with `choose`
+    (heard_at_chosen_warp), each clip at its chosen warp, and the mean warp chosen per voice."""
     tally = art.ContentTally(cfg.content_classes)
+    chosen: dict[str, list[float]] = {}
     for c in clips:
-        tally.add(heard(enc, c.mel, warps).numpy(), c.phones[:: cfg.content_stride], c.voice)
+        labels = c.phones[:: cfg.content_stride]
+        if choose:
+            logits, w = heard_at_chosen_warp(enc, c.mel, warps, choose, labels)
+            chosen.setdefault(art.voice_family(c.voice), []).append(w)
+        else:
+            logits = heard(enc, c.mel, warps)
+        tally.add(logits.numpy(), labels, c.voice)
     s = tally.summary()
+    rows = tally.voices()
+    for r in rows:
+        if r["voice"] in chosen:
+            r["mean_warp_chosen"] = float(np.mean(chosen[r["voice"]]))
     return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
-            "bilabial_segments": s["bilabial_segments"], "by_voice": tally.voices()}
+            "bilabial_segments": s["bilabial_segments"], **art.accuracy_by_kind(np.array(s["confusion"])), "by_voice": rows}
 
 
 def main(argv=None) -> int:
@@ -62,6 +99,9 @@ def main(argv=None) -> int:
     ap.add_argument("--split", default="val,test", help="the corpus's splits to measure on, comma-separated (default: val,test)")
     ap.add_argument("--warps", default="1", help="Mel-axis warp factors whose log-posteriors are averaged, comma-separated "
                     "(default 1: the front-end as it runs; 0.92,1,1.08: test-time averaging over three vocal-tract lengths)")
+    ap.add_argument("--choose-warp", choices=("entropy", "oracle"),
+                    help="hear each clip through one of --warps, chosen by the posteriors' certainty (entropy) or against "
+                         "the alignment (oracle: a bound), instead of averaging them")
     ap.add_argument("--out", type=Path, help="also write the figures here (JSON)")
     args = ap.parse_args(argv)
     args.split = [s for s in args.split.split(",") if s]
@@ -71,13 +111,15 @@ def main(argv=None) -> int:
         ap.error(f"--warps: {args.warps!r} is not a comma-separated list of numbers")
     if any(not 0.5 <= w <= 2 for w in warps):
         ap.error(f"--warps: factors between 0.5 and 2, not {args.warps}")
+    if args.choose_warp and len(warps) < 2:
+        ap.error("--choose-warp: give two or more --warps to choose from")
     ds = open_dataset(args.corpus)
     audio = AudioConfig()
     clips = {s: [prepare(ds, k, audio) for k in ds.keys(s)] for s in args.split}
     results = {}
     for path in args.frontends:
         enc, cfg = load_encoder(path)
-        results[path] = {s: measure(enc, cfg, clips[s], warps) for s in args.split}
+        results[path] = {s: measure(enc, cfg, clips[s], warps, args.choose_warp) for s in args.split}
     pct = lambda x: f"{100 * x:.1f}%"
     for s in args.split:
         print(f"\n{s} split ({len(clips[s])} clips): frame accuracy, /p b m/ segments heard")
@@ -91,6 +133,15 @@ def main(argv=None) -> int:
                 row = next(x for x in r[s]["by_voice"] if x["voice"] == v)
                 cells.append(f"{pct(row['frame_accuracy']):>6} ({row['bilabial_segments_heard']}/{row['bilabial_segments']})")
             print(f"    {v:28s} {row['frames']:6d} frames  " + "  ".join(cells))
+        print(f"  where the frames are lost (vowels / consonants / speech frames in the right lip group; one block per front-end):")
+        for v in ["all", *voices]:
+            cells = []
+            for r in results.values():
+                row = r[s] if v == "all" else next(x for x in r[s]["by_voice"] if x["voice"] == v)
+                warp = f" warp {row['mean_warp_chosen']:.3f}" if "mean_warp_chosen" in row else ""
+                cells.append(f"{pct(row['vowel_frame_accuracy']):>6} / {pct(row['consonant_frame_accuracy']):>6} / "
+                             f"{pct(row['lip_group_accuracy']):>6}{warp}")
+            print(f"    {v:28s} " + "   ".join(cells))
     if args.out:
         args.out.write_text(json.dumps(results, indent=1))
         print(f"\nwritten: {args.out}")

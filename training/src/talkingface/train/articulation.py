@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.contours import lip_gap
-from ..phones import BILABIALS, OPEN_VOWELS, PHONES, SILENCE
+from ..phones import BILABIALS, LIP_GROUP_OF, OPEN_VOWELS, PHONES, SILENCE, VOWELS
 from ..template import Template
 
 CLOSED_MM = 1.0   # inner lips this close count as closed
@@ -153,8 +153,25 @@ def content_summary(conf: np.ndarray, heard: tuple[int, int]) -> dict:
     speech = [i for i in range(len(PHONES)) if PHONES[i] != SILENCE]
     return {"frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
             "speech_frame_accuracy": float(np.diag(conf)[speech].sum() / max(conf[speech].sum(), 1)),
-            "bilabial_segments_heard": heard[0] / max(heard[1], 1), "bilabial_segments": heard[1],
+            "bilabial_segments_heard": heard[0] / max(heard[1], 1), "bilabial_segments": heard[1], **accuracy_by_kind(conf),
             "recall": recall, "confusion": conf.tolist()}
+
+
+def accuracy_by_kind(conf: np.ndarray) -> dict:
+    """From a (D, D) confusion (rows: the alignment's phone; the blank class last): frame accuracy on vowel frames and
+    on consonant frames, and on speech frames the share heard as a phone of the same lip group (phones.LIP_GROUPS: what
+    a viewer would see; the blank counts as no group)."""
+    n = len(PHONES)
+    vowel = np.array([p in VOWELS for p in PHONES])
+    consonant = ~vowel & (np.array(PHONES) != SILENCE)
+    group = np.array([LIP_GROUP_OF[p] for p in PHONES])
+    same = np.zeros(conf.shape, bool)
+    same[:n, :n] = group[:, None] == group[None, :]
+    rate = lambda rows, hits: float(hits / max(conf[:n][rows].sum(), 1))
+    diag = np.diag(conf)[:n]
+    return {"vowel_frame_accuracy": rate(vowel, diag[vowel].sum()),
+            "consonant_frame_accuracy": rate(consonant, diag[consonant].sum()),
+            "lip_group_accuracy": rate(vowel | consonant, (conf[:n] * same[:n])[vowel | consonant].sum())}
 
 
 def voice_family(voice: str) -> str:
@@ -166,7 +183,8 @@ def voice_family(voice: str) -> str:
 def voice_rows(by_voice: dict) -> list[dict]:
     """{voice: [clips, (D, D) confusion, heard, segments]} -> rows of the per-voice table, the most frames first."""
     rows = [{"voice": v, "clips": n, "frames": int(conf.sum()), "frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
-             "bilabial_segments_heard": h, "bilabial_segments": segs} for v, (n, conf, h, segs) in by_voice.items()]
+             "bilabial_segments_heard": h, "bilabial_segments": segs, **accuracy_by_kind(conf)}
+            for v, (n, conf, h, segs) in by_voice.items()]
     return sorted(rows, key=lambda r: -r["frames"])
 
 
