@@ -44,3 +44,28 @@ def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, traine
         head_motion.main(base)
     res = {"head_motion": {"fit": fit}}
     assert "--against-mean" in evaluate.hm.fit_note(res["head_motion"]["fit"])
+
+
+def test_the_issue_targets_read_the_evaluation(corpus, trained_run, tmp_path):
+    import json
+    from talkingface.train import targets
+    out = tmp_path / "test.json"
+    assert evaluate.main(["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--out", str(out)]) == 0
+    res = json.loads(out.read_text())
+    rows = {r["measure"]: r for r in res["targets"]["all"]}
+    a, c = res["articulation"]["all"], res["content_encoder"]["all"]
+    assert rows["/p b m/ closed"]["value"] == a["pred_closure"] and rows["/p b m/ closed"]["met"] == (a["pred_closure"] >= 0.95)
+    assert rows["content encoder frame accuracy"]["met"] == (c["frame_accuracy"] >= 0.70)
+    ratio = res["all"]["lip_motion_pred"] / res["all"]["lip_motion_gt"]
+    assert rows["lip amplitude ratio"]["met"] == (0.9 <= ratio <= 1.1)
+    assert rows["E_vl (mm)"]["met"] == (res["all"]["E_vl"] < targets.E_VL_BEFORE_MM)
+    md = out.with_suffix(".md").read_text()
+    assert "## Issue targets" in md and md.count("| 14 |") == len([r for r in res["targets"]["all"] if r["issue"] == 14])
+    # a made-up evaluation that meets a target and misses another
+    fake = {**res, "articulation": {"all": {**a, "pred_closure": 0.96, "gap_corr": 0.5}, "human": None}, "human": None}
+    rows = {r["measure"]: r for r in targets.check(fake)["all"]}
+    assert rows["/p b m/ closed"]["met"] and not rows["inner-lip gap correlation"]["met"]
+    # another split than the issues' shows none
+    val = tmp_path / "val.json"
+    assert evaluate.main(["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--split", "val", "--out", str(val)]) == 0
+    assert json.loads(val.read_text())["targets"] is None and "Issue targets" not in val.with_suffix(".md").read_text()

@@ -24,6 +24,7 @@ from ..model import head_motion as hmodel
 from ..model import lip_closure as lc
 from . import articulation as art
 from . import head_motion as hm
+from . import targets
 from .data import prepare
 from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
@@ -154,6 +155,8 @@ def main(argv=None) -> int:
     res["head_motion"]["sampled"] = {"seed": args.head_seed} if head is not None else None
     res["head_motion"]["fit"] = ck.get("head_motion_fit") if head is not None else None
     res["eval_seconds"] = time.time() - t0
+    issue_targets = args.split == "test" and not args.oracle_phones  # the issues set them on the test split
+    res["targets"] = targets.check(res) if issue_targets else None
     a = res["all"]
     print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
           f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
@@ -217,6 +220,7 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
         "",
         *art.markdown(res),
         *hm.markdown(res, head_plot),
+        *(targets.markdown(res) if res.get("targets") else []),
     ])
 
 
