@@ -17,6 +17,10 @@ set -euo pipefail
 bank=$1 out=$2 minutes=$3 recipes=${4:-}
 device=${DEVICE:-cuda} python=${PYTHON:-python3}
 export PYTHONPATH=training/src${PYTHONPATH:+:$PYTHONPATH} PYTHONUNBUFFERED=1
+if [[ -n $recipes && ! -r $recipes ]]; then
+  echo "frontend-gpu.sh: no recipes file $recipes" >&2
+  exit 2
+fi
 work=$(mktemp -d)
 mkdir -p "$out"
 
@@ -36,11 +40,13 @@ every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 5 / 100) * 100; print (e < 
 echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
 
 if [[ -n $recipes ]]; then
+  set -f # the options are words, never file patterns
   while read -r name options; do
     [[ -z $name || $name == \#* ]] && continue
     # shellcheck disable=SC2086  # the options are words
-    train "$name" $options &
+    train "$name" ${options%%#*} &
   done <"$recipes"
+  set +f
 else
   train scratch --lr 2e-3 &
   train scratch-consistent --lr 2e-3 --consistency 1 &

@@ -28,7 +28,7 @@ LIP_GROUPS = {
     "closed": ("P", "B", "M"),
     "lip on teeth": ("F", "V"),
     "tongue between teeth": ("TH", "DH"),
-    "rounded": ("W", "UW", "UH", "OW", "OY", "AO", "R", "ER", "SH", "ZH", "CH", "JH"),
+    "rounded": ("W", "UW", "UH", "OW", "OY", "AO", "R", "ER", "SH", "ZH", "CH", "JH"),  # AO: open (OPEN_VOWELS), lips rounded
     "open": ("AA", "AE", "AH", "AW", "AY"),
     "spread": ("IY", "IH", "EY", "EH", "Y"),
     "lips at rest": ("T", "D", "N", "L", "S", "Z", "K", "G", "NG", "HH"),

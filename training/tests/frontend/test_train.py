@@ -64,6 +64,11 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
                    "--snapshots", "--consistency", "1", "--timbre", "0.5"])
     assert json.loads((from_pack / "frontend_eval.json").read_text())["step"] == 4
     assert {p.name for p in from_pack.glob("frontend-step*.pt")} == {"frontend-step2.pt", "frontend-step4.pt"}
+    one_view = tmp_path / "fe-one-view"  # --timbre without --consistency: each crop heard once, perhaps in another timbre
+    fe_train.main(["--packed", str(packed), "--out", str(one_view), "--steps", "2", "--eval-every", "2", "--threads", "1", "--timbre", "1"])
+    assert json.loads((one_view / "frontend_eval.json").read_text())["step"] == 2
+    with pytest.raises(SystemExit):
+        fe_train.main(["--packed", str(packed), "--out", str(tmp_path / "x"), "--timbre", "1.5"])
 
 
 def test_widening_keeps_the_function_and_the_new_channels_learn():

@@ -58,13 +58,21 @@ def test_the_issue_targets_read_the_evaluation(corpus, trained_run, tmp_path):
     assert rows["content encoder frame accuracy"]["met"] == (c["frame_accuracy"] >= 0.70)
     ratio = res["all"]["lip_motion_pred"] / res["all"]["lip_motion_gt"]
     assert rows["lip amplitude ratio"]["met"] == (0.9 <= ratio <= 1.1)
-    assert rows["E_vl (mm)"]["met"] == (res["all"]["E_vl"] < targets.E_VL_BEFORE_MM)
+    assert rows["E_vl (against the model before)"]["met"] == (res["all"]["E_vl"] < targets.BEFORE_MM["all"]["E_vl"])
+    assert rows["head speed distribution, W1 from the truth's"]["met"] is None  # no bound set: shown, not judged
     md = out.with_suffix(".md").read_text()
     assert "## Issue targets" in md and md.count("| 14 |") == len([r for r in res["targets"]["all"] if r["issue"] == 14])
-    # a made-up evaluation that meets a target and misses another
-    fake = {**res, "articulation": {"all": {**a, "pred_closure": 0.96, "gap_corr": 0.5}, "human": None}, "human": None}
-    rows = {r["measure"]: r for r in targets.check(fake)["all"]}
+    judged = [r for part in res["targets"].values() for r in part if r["met"] is not None]
+    assert f"{sum(r['met'] for r in judged)} of {len(judged)} met." in md
+    # a made-up evaluation that meets a target and misses another; a subset with no /p b m/ reads "-", not 0%
+    fake = {**res, "human": res["all"],
+            "articulation": {"all": {**a, "pred_closure": 0.96, "gap_corr": 0.5}, "human": {**a, "bilabial_segments": 0, "pred_closure": 0.0}},
+            "content_encoder": {**res["content_encoder"], "human": c}, "head_motion": {**res["head_motion"], "human": res["head_motion"]["all"]}}
+    checked = targets.check(fake)
+    rows = {r["measure"]: r for r in checked["all"]}
     assert rows["/p b m/ closed"]["met"] and not rows["inner-lip gap correlation"]["met"]
+    closed = next(r for r in checked["human"] if r["measure"] == "/p b m/ closed")
+    assert closed["value"] is None and closed["met"] is None
     # another split than the issues' shows none
     val = tmp_path / "val.json"
     assert evaluate.main(["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--split", "val", "--out", str(val)]) == 0

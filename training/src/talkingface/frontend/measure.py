@@ -88,7 +88,8 @@ def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ..
         if r["voice"] in chosen:
             r["mean_warp_chosen"] = float(np.mean(chosen[r["voice"]]))
     return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
-            "bilabial_segments": s["bilabial_segments"], **art.accuracy_by_kind(np.array(s["confusion"])), "by_voice": rows}
+            "bilabial_segments": s["bilabial_segments"], "vowel_frame_accuracy": s["vowel_frame_accuracy"],
+            "consonant_frame_accuracy": s["consonant_frame_accuracy"], "lip_group_accuracy": s["lip_group_accuracy"], "by_voice": rows}
 
 
 def main(argv=None) -> int:
@@ -133,7 +134,7 @@ def main(argv=None) -> int:
                 row = next(x for x in r[s]["by_voice"] if x["voice"] == v)
                 cells.append(f"{pct(row['frame_accuracy']):>6} ({row['bilabial_segments_heard']}/{row['bilabial_segments']})")
             print(f"    {v:28s} {row['frames']:6d} frames  " + "  ".join(cells))
-        print(f"  where the frames are lost (vowels / consonants / speech frames in the right lip group; one block per front-end):")
+        print("  where the frames are lost (vowels / consonants / speech frames in the right lip group; one block per front-end):")
         for v in ["all", *voices]:
             cells = []
             for r in results.values():

@@ -167,6 +167,8 @@ def main(argv=None) -> int:
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
+    if not 0 <= args.timbre <= 1:
+        ap.error(f"--timbre: a fraction of the crops, between 0 and 1, not {args.timbre}")
     if args.device.startswith("cuda") and not torch.cuda.is_available():
         raise SystemExit(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
     torch.set_num_threads(args.threads)
