@@ -48,7 +48,12 @@ def heard(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...] = (1.0,
     warped by each (test-time averaging over vocal-tract lengths, as the training's frequency warp)."""
     if tuple(warps) == (1.0,):
         return enc(torch.from_numpy(mel)[None])[0]
-    return torch.stack([enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]).mean(0)
+    return torch.stack(warped_log_posteriors(enc, mel, warps)).mean(0)
+
+
+def warped_log_posteriors(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...]) -> list[torch.Tensor]:
+    """The clip's (Kc, D) log-posteriors with its Mel axis warped by each of `warps`."""
+    return [enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]
 
 
 @torch.no_grad()
@@ -57,7 +62,7 @@ def heard_at_chosen_warp(enc: ContentEncoder, mel: np.ndarray, warps: tuple[floa
     """The clip heard through the one of `warps` that `how` picks: "entropy", the lowest mean entropy of the
     posteriors over the clip's frames; "oracle", the highest frame accuracy against `labels` (the content frames'
     phones). -> ((Kc, D) log-posteriors, the warp)."""
-    lps = [enc(torch.from_numpy(warp_mel(mel, w).astype(np.float32))[None])[0].log_softmax(-1) for w in warps]
+    lps = warped_log_posteriors(enc, mel, warps)
     if how == "entropy":
         score = [float((lp.exp() * lp).sum(-1).mean()) for lp in lps]  # minus the entropy: higher is more certain
     elif how == "oracle":
@@ -87,9 +92,9 @@ def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ..
     for r in rows:
         if r["voice"] in chosen:
             r["mean_warp_chosen"] = float(np.mean(chosen[r["voice"]]))
-    return {"frame_accuracy": s["frame_accuracy"], "bilabial_segments_heard": s["bilabial_segments_heard"],
-            "bilabial_segments": s["bilabial_segments"], "vowel_frame_accuracy": s["vowel_frame_accuracy"],
-            "consonant_frame_accuracy": s["consonant_frame_accuracy"], "lip_group_accuracy": s["lip_group_accuracy"], "by_voice": rows}
+    kept = ("frame_accuracy", "bilabial_segments_heard", "bilabial_segments", "vowel_frame_accuracy",
+            "consonant_frame_accuracy", "lip_group_accuracy")
+    return {**{k: s[k] for k in kept}, "by_voice": rows}
 
 
 def main(argv=None) -> int:
