@@ -44,6 +44,14 @@ def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, traine
         head_motion.main(base)
     res = {"head_motion": {"fit": fit}}
     assert "--against-mean" in evaluate.hm.fit_note(res["head_motion"]["fit"])
+    # the head-motion measures average several draws per clip; the paper's metrics and one draw's figures take the first
+    model, ck = train.load_checkpoint(fitted, corpus.template)
+    head = evaluate.hmodel.HeadMotion.from_dict(ck["head_motion"])
+    one = evaluate.evaluate(model, corpus, "test", head=head, head_draws=1)
+    three = evaluate.evaluate(model, corpus, "test", head=head, head_draws=3)
+    assert three["all"] == one["all"] and len(three["head_motion"]["all"]["spread_ratio_draws"]) == 3
+    assert three["head_motion"]["all"]["spread_ratio_draws"][0] == one["head_motion"]["all"]["spread_ratio"]
+    assert three["head_motion"]["all"]["spread_ratio"] != one["head_motion"]["all"]["spread_ratio"]
 
 
 def test_the_issue_targets_read_the_evaluation(corpus, trained_run, tmp_path):

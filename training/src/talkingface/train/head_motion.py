@@ -85,6 +85,15 @@ def plot_speed_histogram(rows: list[dict], path: Path, title: str) -> None:
     plt.close(fig)
 
 
+def sampled_note(sampled: dict) -> str:
+    draws = sampled.get("draws", 1)
+    return (f"Predicted: the pose head's mean pose plus the head's own motion (model/head_motion.py), test clip i's first draw "
+            f"with seed {sampled['seed']} + i" + (f", and {draws - 1} more per clip (`--head-draws {draws}`): the spread, speed, W1 "
+            "and follows-speech figures average them, and \"one draw's spread ratio\" is the range of the ratio over the draws "
+            "taken one at a time (what a single seed per clip could report); jitter and the paper's metrics take the first draw"
+            if draws > 1 else "") + ". `--mean-pose` measures the mean alone (spread ratio 0.11 before the head's own motion).")
+
+
 def fit_note(fit: dict | None) -> str:
     """How the checkpoint's head motion was fitted (model.head_motion records it), in words; empty when not recorded."""
     if not fit:
@@ -94,14 +103,25 @@ def fit_note(fit: dict | None) -> str:
     return f" Fitted on the {fit['split']} split, residuals {origin}, {readout}, gain on the {fit['gain']}."
 
 
+def summarise_draws(rows: list[dict]) -> dict | None:
+    """summarise() over every draw's rows (each clip counted once per draw: the measures' expectation over draws), with
+    the spread ratio of each draw on its own ("spread_ratio_draws": how far one draw per clip can land from it)."""
+    out = summarise(rows)
+    if out is not None:
+        draws = sorted({r.get("draw", 0) for r in rows})
+        out["spread_ratio_draws"] = [summarise([r for r in rows if r.get("draw", 0) == k])["spread_ratio"] for k in draws]
+    return out
+
+
 def markdown(res: dict, plot_name: str) -> list[str]:
     rows = []
     for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
         h, m = res["head_motion"][name], res[name]
         if h:
-            ax = h["spread_ratio_axes"]
+            ax, each = h["spread_ratio_axes"], h.get("spread_ratio_draws") or []
+            spread_range = f"{min(each):.2f} - {max(each):.2f}" if len(each) > 1 else "-"
             rows.append(f"| {label} | {h['spread_true_deg']:.2f} / {h['spread_pred_deg']:.2f} | **{h['spread_ratio']:.2f}** "
-                        f"({ax['pitch']:.2f} / {ax['yaw']:.2f} / {ax['roll']:.2f}) | {h['speed_true_mean_deg']:.3f} / "
+                        f"({ax['pitch']:.2f} / {ax['yaw']:.2f} / {ax['roll']:.2f}) | {spread_range} | {h['speed_true_mean_deg']:.3f} / "
                         f"{h['speed_pred_mean_deg']:.3f} | {h['speed_wasserstein_deg']:.3f} | {h['follow_true']:.2f} / "
                         f"{h['follow_pred']:.2f} | {m['pose_jitter_gt_deg']:.3f} / {m['pose_jitter_deg']:.3f} |")
     return [
@@ -112,12 +132,10 @@ def markdown(res: dict, plot_name: str) -> list[str]:
         "between the true and predicted speed distributions (degrees). Follows speech: correlation within a clip of",
         "the head's speed with the speech envelope's change, true / predicted. Jitter: true / predicted.",
         "",
-        *([f"Predicted: the pose head's mean pose plus the head's own motion (model/head_motion.py), test clip i drawn "
-           f"with seed {res['head_motion']['sampled']['seed']} + i (so the measures average many draws); `--mean-pose` "
-           "measures the mean alone (spread ratio 0.11 before the head's own motion)." + fit_note(res["head_motion"].get("fit")), ""]
+        *([sampled_note(res["head_motion"]["sampled"]) + fit_note(res["head_motion"].get("fit")), ""]
           if res["head_motion"].get("sampled") else ["Predicted: the pose head's mean pose alone.", ""]),
-        "| clips | spread (deg) | spread ratio (pitch / yaw / roll) | speed (deg/frame) | speed W1 | follows speech | jitter (deg) |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| clips | spread (deg) | spread ratio (pitch / yaw / roll) | one draw's spread ratio | speed (deg/frame) | speed W1 | follows speech | jitter (deg) |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
         *rows,
         "",
         f"![head movement distribution, truth against model (the paper's Fig. 4)]({plot_name})",
