@@ -3,9 +3,12 @@
  * Chromium session (dev/compare.html), each run as its authors ship it; writes docs/results/peers.md and .json.
  *
  *   npm run compare [-- --corpus data/corpus --max-clips 80]
+ *   npm run compare -- --samples runs/reserved --out docs/results/peers-reserved
  *
  * Clips: the corpus's test split (unseen voices, sentences and faces) when it is built, else the three sample
- * clips in models/samples. The same segment measures for every system, each on the output it has:
+ * clips in models/samples; with --samples DIR, the clips of DIR/index.json (models/samples' form: name, source, audio,
+ * phones), such as the reserved recordings of real speakers (`scripts/py -m talkingface.train.reserved export DIR`).
+ * --out BASE writes BASE.md and BASE.json instead of docs/results/peers.*. The same segment measures for every system, each on the output it has:
  * - this project: the inner-lip gap (closed below 1 mm, open above 3 mm), as talkingface.train.evaluate;
  * - HeadAudio: its viseme at each 16 ms step (no event = sil): closed = PP, open = aa, O or E;
  * - wlipsync: its vowel class and volume every 16 ms, calibrated (as uLipSync is) on vowels of the corpus's train
@@ -26,6 +29,8 @@ const args = process.argv.slice(2);
 const opt = (name: string, fallback: string) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
 const CORPUS = resolve(ROOT, opt('--corpus', 'data/corpus'));
 const MAX_CLIPS = Number(opt('--max-clips', '80'));
+const SAMPLES = args.includes('--samples') ? resolve(ROOT, opt('--samples', '')) : null;
+const OUT = resolve(ROOT, opt('--out', 'docs/results/peers'));
 const PORT = 4193;
 const BILABIALS = new Set(['P', 'B', 'M']);
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']); // corpus/checks.py OPEN_VOWELS
@@ -58,7 +63,19 @@ function calibrationSnapshots(perClass = 16): Record<string, number[][]> | null 
 type Phone = [string, number, number];
 interface Clip { key: string; source: string; samples: Float32Array; phones: Phone[] }
 
+function loadSamples(dir: string, what: string): { clips: Clip[]; from: string } {
+  const index = resolve(dir, 'index.json');
+  if (!existsSync(index)) throw new Error(`no ${index}: --samples names a folder with an index.json (models/samples' form)`);
+  const clips = JSON.parse(readFileSync(index, 'utf8')).clips.slice(0, MAX_CLIPS);
+  return {
+    from: `the ${clips.length} ${what}`,
+    clips: clips.map((c: { name: string; source: string; audio: string; phones: Phone[] }) =>
+      ({ key: c.name, source: c.source, samples: readWav16(resolve(dir, c.audio)), phones: c.phones })),
+  };
+}
+
 function loadClips(): { clips: Clip[]; from: string } {
+  if (SAMPLES) return loadSamples(SAMPLES, `clips in ${SAMPLES.replace(ROOT + '/', '')}`);
   if (existsSync(resolve(CORPUS, 'splits.json'))) {
     const keys: string[] = JSON.parse(readFileSync(resolve(CORPUS, 'splits.json'), 'utf8')).test.slice(0, MAX_CLIPS);
     return {
@@ -69,12 +86,7 @@ function loadClips(): { clips: Clip[]; from: string } {
       }),
     };
   }
-  const index = JSON.parse(readFileSync(resolve(ROOT, 'models/samples/index.json'), 'utf8'));
-  return {
-    from: `the ${index.clips.length} sample clips in models/samples (no corpus at ${CORPUS})`,
-    clips: index.clips.map((c: { name: string; source: string; audio: string; phones: Phone[] }) =>
-      ({ key: c.name, source: c.source, samples: readWav16(resolve(ROOT, 'models/samples', c.audio)), phones: c.phones })),
-  };
+  return loadSamples(resolve(ROOT, 'models/samples'), `sample clips in models/samples (no corpus at ${CORPUS})`);
 }
 
 /** Output frames of a system whose frame k shows t = k * step (+ offset) that fall in [a, b); the nearest if none. */
@@ -204,8 +216,8 @@ async function main() {
     } else {
       result.not_run['wlipsync 1.3.1'] = 'needs a uLipSync profile calibrated on speech; built from the corpus\'s train split, which is not built here';
     }
-    writeFileSync(resolve(ROOT, 'docs/results/peers.json'), JSON.stringify(result, null, 1) + '\n');
-    writeFileSync(resolve(ROOT, 'docs/results/peers.md'), markdown(result));
+    writeFileSync(`${OUT}.json`, JSON.stringify(result, null, 1) + '\n');
+    writeFileSync(`${OUT}.md`, markdown(result));
     console.log(markdown(result));
   } finally {
     await browser.close();
@@ -220,12 +232,13 @@ function markdown(r: { clips: string; audio_seconds: number; systems: Record<str
     for (const [g, label] of [['all', 'all'], ['human', 'recorded speech']] as const) {
       const m = s[g];
       if (!m.bilabial_segments) continue;
+      if (g === 'human' && m.bilabial_segments === s.all.bilabial_segments && m.pauses === s.all.pauses) continue; // every clip is recorded speech
       rows.push(`| ${name} | ${label} | ${m.bilabial_segments} | **${pct(m.closure)}** / ${pct(m.false_closure)} / ${pct(m.chance_closure)} | ${pct(m.open_vowel_opened)} | ${pct(m.rest_in_pauses)} of ${m.pauses} | ${g === 'all' ? s.ms_per_audio_second.toFixed(1) : ''} | ${g === 'all' ? s.algorithmic_latency_ms : ''} |`);
     }
   }
   return [
     '# Peers side by side', '',
-    `Made by \`npm run compare\` on ${r.clips} (${r.audio_seconds.toFixed(0)} s of audio), every system in the same headless Chromium session.`,
+    `Made by \`npm run compare${args.length ? ' -- ' + args.join(' ') : ''}\` on ${r.clips} (${r.audio_seconds.toFixed(0)} s of audio), every system in the same headless Chromium session.`,
     'Closed: the mouth closed (our gap < 1 mm; HeadAudio\'s PP viseme) at one or more output frames of a /p b m/ segment; false: the same in',
     'other speech segments; chance: the same output shifted in time against the phones. Open: an open vowel (80 ms or more) with the mouth',
     'open (gap > 3 mm; aa, E or O). Rest: pauses of 0.3 s or more at rest on most of their frames (gap < 1 mm; sil or no viseme).',
