@@ -148,12 +148,17 @@ def markdown(res: dict, command: str) -> str:
         "the browser applies it. /p b m/ closed: the inner lips meet (gap < 1 mm) at a frame of the segment; false closures: "
         "the same in other speech; chance: the same lips shifted in time against the phones.",
         "",
-        "| checkpoint | frame accuracy | /p b m/ heard | /p b m/ closed | false closures | chance | open vowels opened |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        "Frame accuracy counts the pauses too; the next column is the speech frames alone: vowels, consonants, and frames "
+        "heard as a phone of the right lip group (what a viewer would see, phones.LIP_GROUPS).",
+        "",
+        "| checkpoint | frame accuracy | speech: vowels / consonants / lip group | /p b m/ heard | /p b m/ closed | false closures | chance | open vowels opened |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in runs:
         c, f = r["content_encoder"], r["face"]
-        lines.append(f"| `{r['checkpoint']}` | {_pct(c['frame_accuracy'])} | {_pct(c['bilabial_segments_heard'])} of {c['bilabial_segments']} | "
+        lines.append(f"| `{r['checkpoint']}` | {_pct(c['frame_accuracy'])} | {_pct(c['vowel_frame_accuracy'])} / "
+                     f"{_pct(c['consonant_frame_accuracy'])} / {_pct(c['lip_group_accuracy'])} | "
+                     f"{_pct(c['bilabial_segments_heard'])} of {c['bilabial_segments']} | "
                      f"{_pct(f['closure'])} | {_pct(f['false_closure'])} | {_pct(f['chance_closure'])} | "
                      f"{_pct(f['open_vowel_opened'])} of {f['open_vowel_segments']} |")
     lines += ["", "By speaker: frame accuracy; /p b m/ segments heard, and closed, of those the speaker said (one column per "
