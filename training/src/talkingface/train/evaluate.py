@@ -30,10 +30,10 @@ from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
 
 # The head-motion measures average this many draws of the head's own motion per clip: one draw per clip leaves the
-# spread of a subset of a few clips to chance (recorded speech's 11 test clips: a ratio from 1.10 to 1.39 over eight
-# seeds, docs/results/README.md), the expectation is what a re-rolling visitor sees.
+# spread of a subset of a few clips to chance (recorded speech's 11 test clips: a ratio from 1.13 to 1.41 over the
+# eight draws, docs/results/default.md), the expectation is what a re-rolling visitor sees.
 HEAD_DRAWS = 8
-DRAW_STRIDE = 100_003
+DRAW_STRIDE = 100_003  # more clips than any split has, so no two (clip, draw) pairs share a seed
 
 
 def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | None = None, head=None, seed: int = 0,

@@ -52,7 +52,7 @@ def measures(res: dict, part: str) -> list[dict]:
     row(15, "head speed distribution, W1 from the truth's", h and h["speed_wasserstein_deg"], unit=" deg")
     follow = h["follow_pred"] / h["follow_true"] if h and h["follow_true"] > 0 else None
     row(15, "follows speech, against the truth", follow, 0.5)
-    row(15, "jitter, against the truth's", _ratio(m, "pose_jitter_deg", "pose_jitter_gt_deg"), 0.5, 2.0)
+    row(15, "jitter, against the truth's", _ratio(h, "jitter_pred_deg", "jitter_true_deg"), 0.5, 2.0)
     return rows
 
 
