@@ -29,7 +29,10 @@ const args = process.argv.slice(2);
 function opt(name: string, fallback: string): string {
   if (!args.includes(name)) return fallback;
   const value = args[args.indexOf(name) + 1];
-  if (value === undefined || value.startsWith('--')) throw new Error(`${name} needs a value`);
+  if (value === undefined || value.startsWith('--')) {
+    console.error(`compare: ${name} needs a value`);
+    process.exit(2);
+  }
   return value;
 }
 const CORPUS = resolve(ROOT, opt('--corpus', 'data/corpus'));
