@@ -6,6 +6,8 @@ names into the manifest for the browser.
 """
 from __future__ import annotations
 
+import numpy as np
+
 SILENCE = "SIL"
 BLANK = "<blank>"  # the CTC-style blank class after the phones (as DeepSpeech's alphabet + blank)
 # The 39 ARPAbet phones of CMUdict plus silence.
@@ -17,6 +19,14 @@ PHONES = (
 PHONE_INDEX = {p: i for i, p in enumerate(PHONES)}
 # The content encoder's classes in logit order.
 CONTENT_CLASSES = (*PHONES, BLANK)
+
+
+def frame_labels(phones, n_frames: int, rate: float, dtype=np.int64) -> np.ndarray:
+    """(n_frames,) phone classes at `rate` frames per second from (phone, start s, end s) segments, silence elsewhere."""
+    labels = np.full(n_frames, PHONE_INDEX[SILENCE], dtype)
+    for p, a, b in phones:
+        labels[int(round(a * rate)) : int(round(b * rate))] = PHONE_INDEX[p]
+    return labels
 
 VOWELS = frozenset("AA AE AH AO AW AY EH ER EY IH IY OW OY UH UW".split())
 OPEN_VOWELS = frozenset(("AA", "AE", "AH", "AO", "AW", "AY"))

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from talkingface.corpus.speech import Voice, synthesize
-from talkingface.phones import PHONE_INDEX, SILENCE
+from talkingface.phones import PHONE_INDEX, SILENCE, frame_labels
 from talkingface.train import reserved, reserved_sources
 from talkingface.wav import write_wav
 from tests.speech_tools import needs_speech_tools
@@ -109,7 +109,7 @@ def test_nothing_else_reads_the_reserved_recordings():
 
 
 def test_frame_labels():
-    labels = reserved.frame_labels([("SIL", 0.0, 0.1), ("P", 0.1, 0.2), ("AA", 0.2, 0.35)], 40, 100.0)
+    labels = frame_labels([("SIL", 0.0, 0.1), ("P", 0.1, 0.2), ("AA", 0.2, 0.35)], 40, 100.0)
     assert (labels[:10] == PHONE_INDEX[SILENCE]).all() and (labels[10:20] == PHONE_INDEX["P"]).all()
     assert (labels[20:35] == PHONE_INDEX["AA"]).all() and (labels[35:] == PHONE_INDEX[SILENCE]).all()
 

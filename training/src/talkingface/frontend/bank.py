@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -97,6 +98,14 @@ def spec_augment(x: torch.Tensor, rng: np.random.Generator) -> torch.Tensor:
     return x * keep[0][:, :, None] * keep[1][:, None, :]
 
 
+@lru_cache(maxsize=4)
+def _dct(M: int, device: torch.device) -> torch.Tensor:
+    """(M, M) orthonormal DCT-II matrix (coefficients x bands), built once per size and device, not every step."""
+    k = torch.arange(M, device=device, dtype=torch.float32)
+    m = (k + 0.5) / M
+    return torch.cos(np.pi * k[:, None] * m[None]) * torch.where(k == 0, 1 / np.sqrt(M), np.sqrt(2 / M))[:, None]
+
+
 def timbre(mel: torch.Tensor, rng: np.random.Generator, p: float) -> torch.Tensor:
     """A voice of another timbre, for a fraction `p` of the crops: (1) a smooth random gain along the Mel axis
     (TIMBRE_COSINES cosines of random weight and phase, applied to the energy: a spectral tilt and broad formant
@@ -115,8 +124,8 @@ def timbre(mel: torch.Tensor, rng: np.random.Generator, p: float) -> torch.Tenso
     gain = (weight[:, :, None] * torch.cos(np.pi * order[None, :, None] * m[None, None] + phase[:, :, None])).sum(1)  # (B, M)
     x = torch.log1p(torch.expm1(mel) * gain.exp()[:, None])
     # An orthonormal DCT-II across the bands; the coefficients past each crop's lifter are dropped.
+    dct = _dct(M, dev)                                                                     # (M coef, M band)
     k = torch.arange(M, device=dev, dtype=torch.float32)
-    dct = torch.cos(np.pi * k[:, None] * m[None]) * torch.where(k == 0, 1 / np.sqrt(M), np.sqrt(2 / M))[:, None]  # (M coef, M band)
     kept = torch.from_numpy(rng.integers(TIMBRE_LIFTER[0], TIMBRE_LIFTER[1] + 1, B)).to(dev)
     lifter = (k[None] < kept[:, None]).to(mel.dtype)                                       # (B, M coef)
     smooth = ((x @ dct.T) * lifter[:, None]) @ dct

@@ -46,7 +46,7 @@ from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
 from ..corpus.sentences import generate_sentences
 from ..corpus.speech import Voice, all_voices, fit_to_duration, synthesize
 from ..features import AudioConfig, log_mel
-from ..phones import PHONE_INDEX, SILENCE
+from ..phones import frame_labels
 from ..wav import read_wav, resample
 
 AUGMENT_SHARE = 0.7
@@ -181,13 +181,6 @@ def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
     return audio, phones
 
 
-def frame_labels(phones, n_frames: int, feature_rate: float) -> np.ndarray:
-    lab = np.full(n_frames, PHONE_INDEX[SILENCE], np.int8)
-    for p, a, b in phones:
-        lab[int(round(a * feature_rate)): int(round(b * feature_rate))] = PHONE_INDEX[p]
-    return lab
-
-
 def build_one(args) -> dict:
     spec, out, vocode_share = args
     audio_cfg = AudioConfig()
@@ -206,7 +199,7 @@ def build_one(args) -> dict:
     phones = fit_to_duration(phones, len(audio) / audio_cfg.sample_rate)
     audio, a2 = augment_channel(audio, audio_cfg.sample_rate, rng, strength)
     mel = log_mel(audio, audio_cfg)
-    labels = frame_labels(phones, len(mel), audio_cfg.feature_rate)
+    labels = frame_labels(phones, len(mel), audio_cfg.feature_rate, np.int8)
     np.savez(Path(out) / f"{spec.key}.npz", mel=mel.astype(np.float16), labels=labels)
     return asdict(spec) | {"seconds": round(len(audio) / audio_cfg.sample_rate, 3), "augment": a1 | a2 | ({"vocoded": True} if vocoded else {})}
 

@@ -27,7 +27,7 @@ from ..data.datasets import FaceDataset
 from ..features import AudioConfig, frame_to_mel_index, log_mel
 from ..geometry.contours import contour_gap
 from ..model.config import ModelConfig
-from ..phones import PHONE_INDEX, SILENCE
+from ..phones import PHONE_INDEX, SILENCE, frame_labels
 from ..template import Template
 from ..wav import resample
 
@@ -56,9 +56,7 @@ def prepare(ds: FaceDataset, key: str, audio: AudioConfig = AudioConfig()) -> Pr
     clip = ds.load(key)
     mel = log_mel(resample(clip.audio, clip.sample_rate, audio.sample_rate), audio)
     k = mel.shape[0]
-    phones = np.full(k, PHONE_INDEX[SILENCE], dtype=np.int64)
-    for p, a, b in clip.phones or []:
-        phones[int(round(a * audio.feature_rate)) : int(round(b * audio.feature_rate))] = PHONE_INDEX[p]
+    phones = frame_labels(clip.phones or [], k, audio.feature_rate)
     mm = ds.mm_per_unit
     pose = clip.pose if clip.pose is not None else np.zeros((clip.num_frames, 6), np.float32)
     pose = pose.copy()

@@ -33,7 +33,7 @@ import numpy as np
 import torch
 
 from ..features import log_mel
-from ..phones import PHONE_INDEX, SILENCE
+from ..phones import frame_labels
 from ..constants import SAMPLE_RATE
 from ..wav import resample
 from . import articulation as art
@@ -72,14 +72,6 @@ def export(aligned: list[dict], out: Path) -> Path:
     path = out / "index.json"
     path.write_text(json.dumps({"from": "the reserved recordings (talkingface.train.reserved)", "clips": index}, indent=1))
     return path
-
-
-def frame_labels(phones, n: int, rate: float) -> np.ndarray:
-    """(n,) phone classes at `rate` frames per second from (phone, start, end) segments, silence elsewhere."""
-    labels = np.full(n, PHONE_INDEX[SILENCE], dtype=np.int64)
-    for p, a, b in phones:
-        labels[int(round(a * rate)) : int(round(b * rate))] = PHONE_INDEX[p]
-    return labels
 
 
 def measure_checkpoint(path: Path, aligned: list[dict]) -> dict:
