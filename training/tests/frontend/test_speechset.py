@@ -119,32 +119,46 @@ def test_the_vocoder_keeps_the_words_and_replaces_the_source():
     assert zc[int(sr / 300):int(sr / 80)].max() < 0.3 * zc[0]  # no pitch where there was none
 
 
-def test_the_more_voices_option_gives_synthetic_clips_to_rhvoice_and_pico_and_leaves_the_rest(monkeypatch):
-    from talkingface.corpus import more_voices
+@pytest.mark.parametrize("module, voices, option, engine", [
+    ("more_voices", ["rhvoice:bdl", "pico:en-GB"], "more_share", "more"),
+    ("diphone_voices", ["festival:rab", "festival:us1"], "diphone_share", "diphone")])
+def test_a_voices_option_gives_synthetic_clips_to_its_voices_and_leaves_the_rest(monkeypatch, module, voices, option, engine):
+    import importlib
+    voice_module = importlib.import_module(f"talkingface.corpus.{module}")
     monkeypatch.setattr(kokoro, "voice_names", lambda: ["af_a", "bm_b"])
-    monkeypatch.setattr(more_voices, "available", lambda: ["rhvoice:bdl", "pico:en-GB"])
-    plain, more = speechset.plan(20, seed=3), speechset.plan(20, seed=3, more_share=0.3)
-    changed = [(a, b) for a, b in zip(plain, more) if a != b]
+    monkeypatch.setattr(voice_module, "available", lambda: voices)
+    plain, given = speechset.plan(20, seed=3), speechset.plan(20, seed=3, **{option: 0.3})
+    changed = [(a, b) for a, b in zip(plain, given) if a != b]
     synthetic = sum(s.engine != "human" for s in plain)
-    assert all(a.engine != "human" and b.engine == "more" and (a.key, a.text) == (b.key, b.text) for a, b in changed)
+    assert all(a.engine != "human" and b.engine == engine and (a.key, a.text) == (b.key, b.text) for a, b in changed)
+    assert all(0.85 <= b.speed <= 1.15 for _, b in changed)
     assert 0.15 * synthetic < len(changed) < 0.45 * synthetic
-    assert {b.voice for _, b in changed} == {"rhvoice:bdl", "pico:en-GB"}
-    monkeypatch.setattr(more_voices, "available", lambda: [])
-    with pytest.raises(RuntimeError, match="setup --more-voices"):
-        speechset.plan(5, seed=0, more_share=0.3)
+    assert {b.voice for _, b in changed} == set(voices)
+    monkeypatch.setattr(voice_module, "available", lambda: [])
+    with pytest.raises(RuntimeError, match=f"setup --{module.replace('_', '-')}"):
+        speechset.plan(5, seed=0, **{option: 0.3})
 
 
-def test_more_voices_keeps_the_test_splits_accent_and_non_free_voices_out_and_names_a_missing_tool(monkeypatch):
-    from talkingface.corpus import more_voices
-    from talkingface.corpus.speech import SpeechToolError
+def test_the_voice_modules_keep_the_test_splits_voices_and_non_free_voices_out():
+    from talkingface.corpus import diphone_voices, more_voices
+    from talkingface.corpus.speech import FESTIVAL_VOICES
     voices = {v for _, v in more_voices.VOICES}
     assert "alan" not in voices and not voices & {"evgeniy-eng", "lyubov"}  # Scottish (held out by the test split); CC-BY-NC-ND
+    assert not set(diphone_voices.VOICES) & set(FESTIVAL_VOICES)  # ked (held out by the test split) and kal stay the corpus's
+
+
+@pytest.mark.parametrize("module, outside, inside", [("more_voices", "rhvoice:alan", "pico:en-US"),
+                                                     ("diphone_voices", "festival:ked", "festival:us1")])
+def test_a_voice_module_refuses_a_voice_outside_it_and_names_a_missing_tool(monkeypatch, module, outside, inside):
+    import importlib
+    from talkingface.corpus.speech import SpeechToolError
+    voice_module = importlib.import_module(f"talkingface.corpus.{module}")
     with pytest.raises(ValueError, match="unknown voice"):
-        more_voices.synthesize("rhvoice:alan", "a pin", 16000)
-    monkeypatch.setattr(more_voices.shutil, "which", lambda tool: None)
-    assert more_voices.available() == []
-    with pytest.raises(SpeechToolError, match="setup --more-voices"):
-        more_voices.synthesize("pico:en-US", "a pin", 16000)
+        voice_module.synthesize(outside, "a pin", 16000)
+    monkeypatch.setattr(voice_module.shutil, "which", lambda tool: None)
+    assert voice_module.available() == []
+    with pytest.raises(SpeechToolError, match=f"setup --{module.replace('_', '-')}"):
+        voice_module.synthesize(inside, "a pin", 16000)
 
 
 @pytest.mark.skipif(not __import__("shutil").which("RHVoice-test") or not __import__("shutil").which("pico2wave"),
@@ -154,3 +168,15 @@ def test_every_more_voice_says_a_sentence():
     for name in more_voices.available():
         audio = more_voices.synthesize(name, "Maybe the bob will pump the map.", 16000)
         assert 1.2 < len(audio) / 16000 < 4.0 and 0.01 < float(abs(audio).max()) <= 1.0, name
+
+
+@pytest.mark.skipif(not __import__("shutil").which("festival"), reason="festival missing: scripts/py -m talkingface.corpus setup")
+def test_every_installed_diphone_voice_says_a_sentence_and_speed_shortens_it():
+    from talkingface.corpus import diphone_voices
+    voices = diphone_voices.available()
+    if not voices:
+        pytest.skip("no diphone voice installed: scripts/py -m talkingface.corpus setup --diphone-voices")
+    for name in voices:
+        slow, fast = (diphone_voices.synthesize(name, "Maybe the bob will pump the map.", 16000, s) for s in (0.85, 1.15))
+        assert 1.2 < len(slow) / 16000 < 4.0 and 0.01 < float(abs(slow).max()) <= 1.0, name
+        assert len(fast) < 0.9 * len(slow), name

@@ -1,6 +1,6 @@
 """Command line for the synthetic corpus.
 
-  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]] [--foreign-voices] [--more-voices]   install the Debian speech tools (apt) [and Kokoro's voices]
+  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]] [--foreign-voices] [--more-voices] [--diphone-voices]   install the Debian speech tools (apt) [and Kokoro's voices]
   scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
   scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
   scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
@@ -50,6 +50,10 @@ def cmd_setup(args) -> int:
         from . import more_voices
         more_voices.setup()
         print(f"more voices: {' '.join(more_voices.available())}")
+    if args.diphone_voices:  # festival's and MBROLA's diphone voices, MBROLA's from Debian's non-free section
+        from . import diphone_voices
+        diphone_voices.setup()
+        print(f"diphone voices: {' '.join(diphone_voices.available())}")
     from .foreign import FOREIGN_PACKAGES
     wanted = DEBIAN_PACKAGES + (FOREIGN_PACKAGES if args.foreign_voices else ())
     missing = [p for p in wanted if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
@@ -108,6 +112,8 @@ def main(argv=None) -> int:
                     help="and festival's Italian, Czech and Finnish voices, which speak English through a phone map (corpus/foreign.py)")
     st.add_argument("--more-voices", action="store_true",
                     help="and RHVoice's and SVOX Pico's English voices, from Debian's contrib and non-free sections (corpus/more_voices.py)")
+    st.add_argument("--diphone-voices", action="store_true",
+                    help="and festival's rab and don and MBROLA's us1, us2, us3 and en1 (corpus/diphone_voices.py)")
     st.set_defaults(fn=cmd_setup)
     b = sub.add_parser("build", help="build a corpus")
     b.add_argument("--preset", choices=sorted(PRESETS), default="small")

@@ -45,9 +45,9 @@ def available() -> list[str]:
     return [f"{e}:{v}" for e, v in VOICES if shutil.which(TOOLS[e])]
 
 
-def setup() -> None:
-    """Add Debian's contrib and non-free sections (if apt has not got them) and install PACKAGES."""
-    missing = [p for p in PACKAGES if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
+def setup(packages: tuple[str, ...] = PACKAGES) -> None:
+    """Add Debian's contrib and non-free sections (if apt has not got them) and install `packages`."""
+    missing = [p for p in packages if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
     if not missing:
         return
     sudo = [] if os.geteuid() == 0 else ["sudo"]

@@ -1,0 +1,45 @@
+"""A front-end between two: weight by weight on the line from the one a fine-tune started from to the fine-tune."""
+import pytest
+import torch
+
+from talkingface.frontend import measure, soup
+from talkingface.train.train import load_frontend
+
+
+def _shifted(fe: dict, by: float) -> dict:
+    return {**fe, "content": {k: v + by if v.is_floating_point() else v for k, v in fe["content"].items()}}
+
+
+def test_the_soup_is_the_line_between_the_two_and_ends_at_each(trained_run):
+    base = load_frontend(str(trained_run / "final.pt"))
+    tuned = _shifted(base, 1.0)
+    for alpha in (0.0, 0.3, 1.0):
+        mixed = soup.interpolate(base, tuned, alpha)
+        for k, v in base["content"].items():
+            assert torch.allclose(mixed[k], v + alpha, atol=1e-6), (k, alpha)
+    with pytest.raises(ValueError, match="from 0 to 1"):
+        soup.interpolate(base, tuned, 1.2)
+
+
+def test_front_ends_of_other_shapes_or_layers_are_refused_with_the_reason(trained_run):
+    base = load_frontend(str(trained_run / "final.pt"))
+    k = next(k for k, v in base["content"].items() if v.ndim == 2 or v.ndim == 3)
+    wider = {**base, "content": {**base["content"], k: torch.zeros(base["content"][k].shape[0] + 1, *base["content"][k].shape[1:])}}
+    with pytest.raises(ValueError, match="differ in " + k.replace(".", r"\.")):
+        soup.interpolate(base, wider, 0.5)
+    fewer = {**base, "content": {n: v for n, v in base["content"].items() if n != k}}
+    with pytest.raises(ValueError, match="differ in their layers"):
+        soup.interpolate(base, fewer, 0.5)
+
+
+def test_the_command_writes_a_front_end_that_measure_and_the_face_read(trained_run, tmp_path):
+    base = trained_run / "final.pt"
+    tuned = tmp_path / "tuned.pt"
+    torch.save(_shifted(load_frontend(str(base)), 0.5), tuned)
+    out = tmp_path / "soup.pt"
+    assert soup.main([str(base), str(tuned), "--alpha", "0.5", "--out", str(out)]) == 0
+    enc, _ = measure.load_encoder(str(out))
+    want = load_frontend(str(base))["content"]
+    got = enc.state_dict()
+    assert all(torch.allclose(got[k], want[k] + 0.25, atol=1e-6) for k in want if want[k].is_floating_point())
+    assert torch.load(out, weights_only=False)["soup"] == {"base": str(base), "tuned": str(tuned), "alpha": 0.5}
