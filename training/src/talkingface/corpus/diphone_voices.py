@@ -6,8 +6,9 @@ voices, each cut from one real speaker's recordings, all offline:
 
 - festival's rab (British English male, RP) and don (a minimal British English male), Debian main;
 - MBROLA's us1 (US female), us2 and us3 (US males) and en1 (British male), spoken through festival (festvox-us1 ...),
-  Debian non-free (the voices' licence allows non-commercial and research use with the MBROLA binary; they are
-  training speech here, nothing of them ships).
+  Debian non-free (their licence, /usr/share/doc/mbrola-us1/copyright: speech synthesised with the MBROLA program
+  only, and the database not sold nor put into a product that is sold; here they say training sentences, and
+  nothing of them ships).
 
 Not ked, kal and the others the corpus speaks with already (corpus/speech.py). festival's British voices use another
 phone set, so the speech set force-aligns all six, as it does Kokoro's; `speed` stretches festival's durations.
