@@ -85,3 +85,23 @@ def test_the_issue_targets_read_the_evaluation(corpus, trained_run, tmp_path):
     val = tmp_path / "val.json"
     assert evaluate.main(["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--split", "val", "--out", str(val)]) == 0
     assert json.loads(val.read_text())["targets"] is None and "Issue targets" not in val.with_suffix(".md").read_text()
+
+
+def test_closure_causes_retargets_with_the_checkpoints_mouth_gain_as_evaluate_does(corpus, trained_run, tmp_path, monkeypatch):
+    """closure_causes reads the closure as the browser applies it: the calibrated reference gap with the mouth gain it
+    was calibrated with (it once dropped the gain, so a reference fitted for x1.3 closed the lips far too little)."""
+    import torch
+    from talkingface.model import lip_closure as lc
+    from talkingface.train import closure_causes
+    ck = torch.load(trained_run / "final.pt", weights_only=False)
+    ck["lip_closure"] = {"reference_gap_mm": 7.4, "mouth_gain": 1.3}
+    path = tmp_path / "gain.pt"
+    torch.save(ck, path)
+    made = []
+    real = lc.Closers
+    monkeypatch.setattr(lc, "Closers", lambda t, ref, gain=1.0: made.append((ref, gain)) or real(t, ref, gain))
+    assert closure_causes.main(["--corpus", str(corpus.root), "--checkpoint", str(path), "--split", "test"]) == 0
+    assert made == [(7.4, 1.3)]
+    made.clear()
+    assert closure_causes.main(["--corpus", str(corpus.root), "--checkpoint", str(path), "--split", "test", "--raw"]) == 0
+    assert made == []

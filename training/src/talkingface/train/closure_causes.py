@@ -25,11 +25,12 @@ from .data import prepare
 from .train import load_checkpoint
 
 
-def segments(model, ds, split: str, reference_gap: float | None = None) -> list[dict]:
-    """`reference_gap`: retarget the closure to each face with it (model/lip_closure.py), or None."""
+def segments(model, ds, split: str, reference_gap: float | None = None, mouth_gain: float = 1.0) -> list[dict]:
+    """`reference_gap`: retarget the closure to each face with it, the mouth's amplitude scaled by `mouth_gain`
+    (model/lip_closure.py, as evaluate does), or None."""
     bil = [PHONES.index(p) for p in BILABIALS]
     rate = model.audio.feature_rate / model.cfg.content_stride
-    closers = lc.Closers(ds.template, reference_gap) if reference_gap is not None else None
+    closers = lc.Closers(ds.template, reference_gap, mouth_gain) if reference_gap is not None else None
     rows = []
     for key in ds.keys(split):
         c = prepare(ds, key, model.audio)
@@ -86,8 +87,10 @@ def main(argv=None) -> int:
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
-    reference = None if args.raw else args.reference_gap or (ck.get("lip_closure") or {}).get("reference_gap_mm")
-    print("\n".join(report(segments(model, ds, args.split, reference))))
+    closure = ck.get("lip_closure") or {}
+    reference = None if args.raw else args.reference_gap or closure.get("reference_gap_mm")
+    gain = float(closure.get("mouth_gain", 1.0)) if reference is not None else 1.0  # the calibration's own gain
+    print("\n".join(report(segments(model, ds, args.split, reference, gain))))
     return 0
 
 
