@@ -43,3 +43,20 @@ def test_the_command_writes_a_front_end_that_measure_and_the_face_read(trained_r
     got = enc.state_dict()
     assert all(torch.allclose(got[k], want[k] + 0.25, atol=1e-6) for k in want if want[k].is_floating_point())
     assert torch.load(out, weights_only=False)["soup"] == {"base": str(base), "tuned": str(tuned), "alpha": 0.5}
+
+
+def test_with_face_the_result_replaces_that_faces_content_encoder_and_nothing_else(trained_run, tmp_path):
+    face = trained_run / "final.pt"
+    tuned = tmp_path / "tuned.pt"
+    torch.save(_shifted(load_frontend(str(face)), 0.5), tuned)
+    out = tmp_path / "face.pt"
+    assert soup.main([str(face), str(tuned), "--alpha", "1", "--face", str(face), "--out", str(out)]) == 0
+    before, after = torch.load(face, weights_only=False), torch.load(out, weights_only=False)
+    for k, v in before["model"].items():
+        if k.startswith("content.") and v.is_floating_point():
+            assert torch.allclose(after["model"][k], v + 0.5, atol=1e-6), k
+        else:
+            assert torch.equal(after["model"][k], v), k
+    assert after["model_config"] == before["model_config"] and after["frontend_soup"]["alpha"] == 1.0
+    with pytest.raises(SystemExit):
+        soup.main([str(face), str(tuned), "--face", str(tuned), "--out", str(tmp_path / "no.pt")])  # not a face

@@ -11,7 +11,9 @@ result is one network of the same size.
 
 writes (1 - alpha) * BASE + alpha * TUNED, weight by weight (its Mel normalisation included), as a front-end file
 that `frontend.measure` reads and `talkingface.train.train --frontend` puts into a face. BASE and TUNED are front-end
-files or face checkpoints (their content encoder), of one architecture; alpha is chosen on the val split.
+files or face checkpoints (their content encoder), of one architecture; alpha is chosen on the val split. With
+`--face CHECKPOINT` it writes that face checkpoint instead, its content encoder replaced by the result and nothing else
+changed (its lip closure is then recalibrated: model/lip_closure.py); `--alpha 1` puts TUNED itself into the face.
 """
 from __future__ import annotations
 
@@ -51,6 +53,7 @@ def main(argv=None) -> int:
     ap.add_argument("base", help="the front-end the fine-tune started from (a frontend.pt or a face checkpoint)")
     ap.add_argument("tuned", help="the fine-tuned front-end")
     ap.add_argument("--alpha", type=float, default=0.5, help="how far from BASE towards TUNED (default 0.5)")
+    ap.add_argument("--face", help="write this face checkpoint with the result as its content encoder, not a front-end file")
     ap.add_argument("--out", required=True)
     args = ap.parse_args(argv)
     base, tuned = load_frontend(args.base), load_frontend(args.tuned)
@@ -58,11 +61,22 @@ def main(argv=None) -> int:
         content = interpolate(base, tuned, args.alpha)
     except ValueError as e:
         ap.error(str(e))
-    payload = {"content": content, "model_config": tuned["model_config"], "step": tuned.get("step", 0),
-               "audio_config": tuned.get("audio_config"), "history": [],
-               "soup": {"base": args.base, "tuned": args.tuned, "alpha": args.alpha}}
+    made = {"base": args.base, "tuned": args.tuned, "alpha": args.alpha}
+    if args.face:
+        payload = torch.load(args.face, map_location="cpu", weights_only=False)
+        if "model" not in payload:
+            ap.error(f"--face: {args.face} is not a face checkpoint")
+        model = payload["model"]
+        if any(model.get("content." + k) is None or model["content." + k].shape != v.shape for k, v in content.items()):
+            ap.error(f"--face: the content encoder of {args.face} is not of the front-ends' architecture")
+        payload["model"] = {**model, **{"content." + k: v for k, v in content.items()}}
+        payload["frontend_soup"] = made
+    else:
+        payload = {"content": content, "model_config": tuned["model_config"], "step": tuned.get("step", 0),
+                   "audio_config": tuned.get("audio_config"), "history": [], "soup": made}
     torch.save(payload, args.out)
-    print(f"front-end {1 - args.alpha:g} x {args.base} + {args.alpha:g} x {args.tuned} -> {args.out}")
+    into = f" in {args.face}" if args.face else ""
+    print(f"front-end {1 - args.alpha:g} x {args.base} + {args.alpha:g} x {args.tuned}{into} -> {args.out}")
     return 0
 
 
