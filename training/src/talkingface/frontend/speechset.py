@@ -259,26 +259,23 @@ def main(argv=None) -> int:
     ap.add_argument("--kokoro-voices", choices=KOKORO_VOICES, default="english",
                     help="Kokoro's English voices, its accented ones (setup --kokoro-accented), or all of them")
     ap.add_argument("--first", type=int, help="build only the plan's first N clips (the plan itself is that of --minutes)")
-    ap.add_argument("--vocode", type=float, default=0.0, metavar="SHARE",
-                    help="say this share of the clips through a vocoder first: buzzy, as diphone and parametric voices "
-                         "(festival's, flite's) sound (default 0)")
-    ap.add_argument("--foreign", type=float, default=0.0, metavar="SHARE",
-                    help="give this share of the clips to festival's Italian, Czech and Finnish voices speaking English "
-                         "(setup --foreign-voices; corpus/foreign.py) (default 0)")
-    ap.add_argument("--accents", type=float, default=0.0, metavar="SHARE",
-                    help="say this share of Kokoro's clips with one of espeak-ng's English accents (Caribbean, New York, "
-                         "Lancaster, West Midlands, RP; not the Scottish one, which the test split holds out) (default 0)")
-    ap.add_argument("--extrapolate", type=float, default=0.0, metavar="SHARE",
-                    help="say this share of Kokoro's clips with a voice beyond two of its voices (w a + (1 - w) b, "
-                         f"w from {EXTRAPOLATE[0]} to {EXTRAPOLATE[1]}): speakers that are none of its 54 (default 0)")
-    ap.add_argument("--more-voices", type=float, default=0.0, metavar="SHARE",
-                    help="give this share of the synthetic clips to RHVoice's and SVOX Pico's English voices "
-                         "(setup --more-voices; corpus/more_voices.py) (default 0)")
-    ap.add_argument("--diphone-voices", type=float, default=0.0, metavar="SHARE",
-                    help="give this share of the synthetic clips to festival's rab and don and MBROLA's us1, us2, us3 and "
-                         "en1 (setup --diphone-voices; corpus/diphone_voices.py) (default 0)")
+    shares = {  # options that give a share of the clips to something; each drawn from a generator of its own (plan)
+        "vocode": "say this share of the clips through a vocoder first: buzzy, as diphone and parametric voices "
+                  "(festival's, flite's) sound",
+        "foreign": "give this share of the clips to festival's Italian, Czech and Finnish voices speaking English "
+                   "(setup --foreign-voices; corpus/foreign.py)",
+        "accents": "say this share of Kokoro's clips with one of espeak-ng's English accents (Caribbean, New York, "
+                   "Lancaster, West Midlands, RP; not the Scottish one, which the test split holds out)",
+        "extrapolate": "say this share of Kokoro's clips with a voice beyond two of its voices (w a + (1 - w) b, "
+                       f"w from {EXTRAPOLATE[0]} to {EXTRAPOLATE[1]}): speakers that are none of its 54",
+        "more_voices": "give this share of the synthetic clips to RHVoice's and SVOX Pico's English voices "
+                       "(setup --more-voices; corpus/more_voices.py)",
+        "diphone_voices": "give this share of the synthetic clips to festival's rab and don and MBROLA's us1, us2, us3 "
+                          "and en1 (setup --diphone-voices; corpus/diphone_voices.py)"}
+    for name, text in shares.items():
+        ap.add_argument(f"--{name.replace('_', '-')}", type=float, default=0.0, metavar="SHARE", help=f"{text} (default 0)")
     args = ap.parse_args(argv)
-    for name in ("vocode", "foreign", "accents", "extrapolate", "more_voices", "diphone_voices"):
+    for name in shares:
         if not 0.0 <= getattr(args, name) <= 1.0:
             ap.error(f"--{name.replace('_', '-')} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
     meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign, args.accents,
