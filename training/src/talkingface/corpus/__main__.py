@@ -20,7 +20,7 @@ from pathlib import Path
 from .build import build_corpus
 from .clip import ClipBuildError
 from .plan import PRESETS
-from .speech import DEBIAN_PACKAGES, SpeechToolError
+from .speech import DEBIAN_PACKAGES, SpeechToolError, installed
 
 
 def _progress():
@@ -56,7 +56,7 @@ def cmd_setup(args) -> int:
         print(f"diphone voices: {' '.join(diphone_voices.available())}")
     from .foreign import FOREIGN_PACKAGES
     wanted = DEBIAN_PACKAGES + (FOREIGN_PACKAGES if args.foreign_voices else ())
-    missing = [p for p in wanted if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
+    missing = [p for p in wanted if not installed(p)]
     if not missing:
         print("speech tools: all installed")
         return 0

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..wav import read_wav, resample
 from . import more_voices
-from .speech import SpeechToolError
+from .speech import SpeechToolError, festival_script, installed
 
 # voice -> (festival's command that selects it, the Debian package that holds it)
 VOICES = {"rab": ("voice_rab_diphone", "festvox-rablpc16k"), "don": ("voice_don_diphone", "festvox-don"),
@@ -36,15 +36,11 @@ PACKAGES = ("festival", "mbrola", *(pkg for _, pkg in VOICES.values()))
 SETUP = "scripts/py -m talkingface.corpus setup --diphone-voices"
 
 
-def _installed(package: str) -> bool:
-    return subprocess.run(["dpkg", "-s", package], capture_output=True).returncode == 0
-
-
 def available() -> list[str]:
     """The voices whose packages are installed, as "festival:voice"."""
     if shutil.which("festival") is None:
         return []
-    return [f"festival:{v}" for v, (_, pkg) in VOICES.items() if _installed(pkg)]
+    return [f"festival:{v}" for v, (_, pkg) in VOICES.items() if installed(pkg)]
 
 
 def setup() -> None:
@@ -57,15 +53,13 @@ def synthesize(name: str, text: str, sample_rate: int, speed: float = 1.0) -> np
     engine, _, voice = name.partition(":")
     if engine != "festival" or voice not in VOICES:
         raise ValueError(f"unknown voice {name!r}: one of {', '.join(f'festival:{v}' for v in VOICES)}")
-    if shutil.which("festival") is None or not _installed(VOICES[voice][1]):
+    if shutil.which("festival") is None or not installed(VOICES[voice][1]):
         raise SpeechToolError(f"{VOICES[voice][1]} is missing: run `{SETUP}`")
     if not 0.5 <= speed <= 2.0:
         raise ValueError(f"speed {speed} is outside 0.5-2")
     with tempfile.TemporaryDirectory(prefix="diphone-") as tmp:
         wav, scm = Path(tmp) / "out.wav", Path(tmp) / "say.scm"
-        quoted = text.replace("\\", " ").replace('"', "")
-        scm.write_text(f"({VOICES[voice][0]})\n(Parameter.set 'Duration_Stretch {1.0 / speed:.4f})\n"
-                       f'(set! u (utt.synth (Utterance Text "{quoted}")))\n(utt.save.wave u "{wav}" \'riff)\n')
+        scm.write_text(festival_script(VOICES[voice][0], text, wav, settings=f"(Parameter.set 'Duration_Stretch {1.0 / speed:.4f})\n"))
         r = subprocess.run(["festival", "-b", str(scm)], capture_output=True, text=True, timeout=120)
         if r.returncode != 0 or not wav.exists() or wav.stat().st_size < 1000:
             raise SpeechToolError(f"festival ({VOICES[voice][0]}) failed ({r.returncode}): {r.stderr.strip()[-300:]}")

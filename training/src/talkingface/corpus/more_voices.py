@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..wav import read_wav, resample
-from .speech import SpeechToolError
+from .speech import SpeechToolError, installed
 
 PACKAGES = ("rhvoice", "rhvoice-english", "libttspico-utils")
 SOURCES = Path("/etc/apt/sources.list.d/talking-face-contrib-non-free.sources")
@@ -47,7 +47,7 @@ def available() -> list[str]:
 
 def setup(packages: tuple[str, ...] = PACKAGES) -> None:
     """Add Debian's contrib and non-free sections (if apt has not got them) and install `packages`."""
-    missing = [p for p in packages if subprocess.run(["dpkg", "-s", p], capture_output=True).returncode != 0]
+    missing = [p for p in packages if not installed(p)]
     if not missing:
         return
     sudo = [] if os.geteuid() == 0 else ["sudo"]

@@ -79,6 +79,19 @@ def tool_versions() -> dict[str, str]:
     return out
 
 
+def installed(package: str) -> bool:
+    """Whether dpkg has the Debian package installed."""
+    return subprocess.run(["dpkg", "-s", package], capture_output=True).returncode == 0
+
+
+def festival_script(select: str, text: str, wav: Path, segs: Path | None = None, settings: str = "") -> str:
+    """The Scheme that makes festival say `text` with the voice `select` chooses (a command such as voice_kal_diphone),
+    after `settings` (Scheme lines), into the RIFF file `wav`, and its segments' end times into `segs` if given."""
+    quoted = text.replace("\\", " ").replace('"', "")
+    return (f'({select})\n{settings}(set! u (utt.synth (Utterance Text "{quoted}")))\n(utt.save.wave u "{wav}" \'riff)\n'
+            + (f'(utt.save.segs u "{segs}")\n' if segs is not None else ""))
+
+
 def require_tools(*tools: str) -> None:
     missing = [t for t in tools if shutil.which(t) is None]
     if missing:
@@ -103,9 +116,7 @@ def synthesize(voice: Voice, text: str, sample_rate: int) -> tuple[np.ndarray, l
         if voice.engine == "festival":
             require_tools("festival")
             scm = Path(tmp) / "say.scm"
-            quoted = text.replace("\\", " ").replace('"', "")
-            scm.write_text(f'({FESTIVAL_VOICES[voice.name]})\n(set! u (utt.synth (Utterance Text "{quoted}")))\n'
-                           f'(utt.save.wave u "{wav}" \'riff)\n(utt.save.segs u "{Path(tmp) / "out.segs"}")\n')
+            scm.write_text(festival_script(FESTIVAL_VOICES[voice.name], text, wav, Path(tmp) / "out.segs"))
             _run(["festival", "-b", str(scm)])
             phones = _read_festival_segs(Path(tmp) / "out.segs")
         elif voice.engine == "flite":

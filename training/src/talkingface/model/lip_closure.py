@@ -126,6 +126,14 @@ class Closers:
         return self._faces[key]
 
 
+def calibration(ck: dict) -> tuple[float | None, float]:
+    """A checkpoint's lip closure as `main` calibrated it: (reference gap in mm, or None if it has none; mouth gain)."""
+    closure = ck.get("lip_closure")
+    if not closure:
+        return None, 1.0
+    return float(closure["reference_gap_mm"]), float(closure.get("mouth_gain", 1.0))
+
+
 def reference_gap(ds, split: str = "train") -> tuple[float, int]:
     """Mean neutral inner-lip gap (mm) of the faces in `split`, each face counted once."""
     faces = {}

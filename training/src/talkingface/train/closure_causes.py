@@ -87,9 +87,8 @@ def main(argv=None) -> int:
     ds = open_dataset(args.corpus)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
-    closure = ck.get("lip_closure") or {}
-    reference = None if args.raw else args.reference_gap or closure.get("reference_gap_mm")
-    gain = float(closure.get("mouth_gain", 1.0)) if reference is not None else 1.0  # the calibration's own gain
+    reference, gain = (None, 1.0) if args.raw else lc.calibration(ck)  # with the gain it was calibrated with
+    reference = None if args.raw else args.reference_gap or reference
     print("\n".join(report(segments(model, ds, args.split, reference, gain))))
     return 0
 

@@ -166,8 +166,7 @@ def main(argv=None) -> int:
     t0 = time.time()
     heads: list = []
     head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
-    closure = ck["lip_closure"]["reference_gap_mm"] if "lip_closure" in ck and not args.raw_lips else None
-    gain = float(ck["lip_closure"].get("mouth_gain", 1.0)) if closure is not None else 1.0
+    closure, gain = (None, 1.0) if args.raw_lips else lc.calibration(ck)
     if args.head_draws < 1:
         ap.error(f"--head-draws: one or more, not {args.head_draws}")
     res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain,
