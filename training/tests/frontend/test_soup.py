@@ -60,3 +60,31 @@ def test_with_face_the_result_replaces_that_faces_content_encoder_and_nothing_el
     assert after["model_config"] == before["model_config"] and after["frontend_soup"]["alpha"] == 1.0
     with pytest.raises(SystemExit):
         soup.main([str(face), str(tuned), "--face", str(tuned), "--out", str(tmp_path / "no.pt")])  # not a face
+
+
+def test_a_fine_tune_that_gained_a_look_ahead_block_soups_with_the_front_end_without_it(trained_run, corpus, tmp_path):
+    from talkingface.frontend.train import look_further
+    from talkingface.model.config import ModelConfig
+    face = trained_run / "final.pt"
+    base = load_frontend(str(face))
+    cfg = ModelConfig.from_dict(base["model_config"])
+    enc = measure.load_encoder(str(face))[0]
+    ahead_cfg = ModelConfig(**cfg.to_dict() | {"content_ahead": 1})
+    further = look_further(enc, ahead_cfg).state_dict()
+    tuned = tmp_path / "tuned.pt"
+    torch.save({"content": {k: v + 1.0 if v.is_floating_point() else v for k, v in further.items()},
+                "model_config": ahead_cfg.to_dict(), "step": 1}, tuned)
+    out = tmp_path / "soup.pt"
+    assert soup.main([str(face), str(tuned), "--alpha", "0.25", "--out", str(out)]) == 0
+    got = torch.load(out, weights_only=False)
+    assert got["model_config"]["content_ahead"] == 1
+    extra = [k for k in further if k.startswith("blocks.4.")]
+    assert extra and all(torch.allclose(got["content"][k], torch.full_like(further[k], 0.25)) for k in extra)  # 0.75 x 0 + 0.25 x 1
+    into = tmp_path / "face.pt"
+    assert soup.main([str(face), str(tuned), "--alpha", "0.25", "--face", str(face), "--out", str(into)]) == 0
+    written = torch.load(into, weights_only=False)
+    assert written["model_config"]["content_ahead"] == 1
+    from talkingface.train.train import load_checkpoint
+    model, _ = load_checkpoint(into, corpus.template)  # the face loads, its content encoder the soup's
+    for k in extra:
+        torch.testing.assert_close(model.content.state_dict()[k], got["content"][k], rtol=0, atol=0)

@@ -51,6 +51,34 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     train.main(["--corpus", str(corpus.root), "--out", str(run2), "--steps", "1", "--batch-clips", "2", "--frames", "4",
                 "--frontend", str(wide / "frontend.pt")])
     assert train.load_checkpoint(run2 / "final.pt", corpus.template)[0].cfg.content_channels == 160
+    # --ahead adds a look-ahead block; a face initialised from a model without one takes the front-end's, frozen,
+    # and its export reads as many Mel frames further ahead
+    ahead = tmp_path / "fe-ahead"
+    fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(ahead), "--steps", "2",
+                   "--eval-every", "1000", "--threads", "1", "--init", str(out / "frontend.pt"), "--ahead", "1"])
+    fe4 = torch.load(ahead / "frontend.pt", weights_only=False)
+    assert fe4["model_config"]["content_ahead"] == 1 and "blocks.4.conv.weight" in fe4["content"]
+    with pytest.raises(SystemExit, match="not --ahead 2"):
+        fe_train.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(tmp_path / "x"), "--steps", "1",
+                       "--threads", "1", "--init", str(ahead / "frontend.pt"), "--ahead", "2"])
+    run3 = tmp_path / "run3"
+    train.main(["--corpus", str(corpus.root), "--out", str(run3), "--steps", "1", "--batch-clips", "2", "--frames", "4",
+                "--frontend", str(ahead / "frontend.pt"), "--init", str(run / "final.pt")])
+    model3, _ = train.load_checkpoint(run3 / "final.pt", corpus.template)
+    assert model3.cfg.content_ahead == 1
+    for k, v in fe4["content"].items():
+        torch.testing.assert_close(model3.content.state_dict()[k], v, rtol=0, atol=0)
+    # --window-future moves the window of a model initialised from another, which is otherwise refused
+    run4 = tmp_path / "run4"
+    train.main(["--corpus", str(corpus.root), "--out", str(run4), "--steps", "1", "--batch-clips", "2", "--frames", "4",
+                "--frontend", str(ahead / "frontend.pt"), "--init", str(run3 / "final.pt"), "--window-future", "0"])
+    assert train.load_checkpoint(run4 / "final.pt", corpus.template)[0].cfg.window_future == 0
+    with pytest.raises(SystemExit, match="is a"):
+        train.main(["--corpus", str(corpus.root), "--out", str(tmp_path / "x"), "--steps", "1", "--batch-clips", "2",
+                    "--frames", "4", "--frontend", str(ahead / "frontend.pt"), "--init", str(run4 / "final.pt")])
+    with pytest.raises(SystemExit, match="is a"):  # without the front-end, a model of another encoder is still refused
+        train.main(["--corpus", str(corpus.root), "--out", str(tmp_path / "x"), "--steps", "1", "--batch-clips", "2",
+                    "--frames", "4", "--init", str(run3 / "final.pt")])
     # the same speech packed into one file (frontend.bank) trains the same way, its measuring clips inside it
     packed = tmp_path / "bank.npz"
     bank.main(["--speech", str(speech), "--corpus", str(corpus.root), "--out", str(packed)])
@@ -82,6 +110,29 @@ def test_widening_keeps_the_function_and_the_new_channels_learn():
     wide(mel).square().sum().backward()
     grown = wide.blocks[0].conv.weight.grad[32:]  # the weights into the new channels: zero, with a gradient
     assert wide.blocks[0].conv.weight[32:].abs().max() == 0 and grown.abs().max() > 0
+
+
+def test_a_look_ahead_block_keeps_the_function_then_learns_from_the_frames_ahead():
+    from talkingface.model.config import ModelConfig
+    from talkingface.model.encoders import ContentEncoder
+    torch.manual_seed(0)
+    enc = ContentEncoder(ModelConfig(content_channels=32), 80).eval()
+    further = fe_train.look_further(enc, ModelConfig(content_channels=32, content_ahead=2)).eval()
+    mel = torch.randn(2, 60, 80)
+    torch.testing.assert_close(further(mel), enc(mel), rtol=0, atol=0)
+    further(mel).square().sum().backward()
+    assert further.blocks[-1].conv.weight.grad.abs().max() > 0
+    with torch.no_grad():
+        further.blocks[-1].conv.weight.normal_()
+        moved = mel.clone()
+        moved[:, 40] += 1.0  # Mel frame 40 is content frame 20: the block reads 2 content frames ahead of the rest
+        changed = (further(moved) - further(mel)).abs().amax(-1)[0] > 0
+        base = (enc(moved) - enc(mel)).abs().amax(-1)[0] > 0
+    assert int(torch.nonzero(changed)[0]) == int(torch.nonzero(base)[0]) - 2
+    with pytest.raises(ValueError):
+        fe_train.look_further(further, ModelConfig(content_channels=32, content_ahead=1))
+    with pytest.raises(ValueError):
+        ContentEncoder(ModelConfig(content_arch="conv4", content_ahead=1), 80)
 
 
 def test_view_disagreement_is_zero_for_the_same_posteriors_only():

@@ -22,6 +22,7 @@ import sys
 
 import torch
 
+from ..model.encoders import ContentEncoder
 from ..train.train import load_frontend
 
 
@@ -47,6 +48,21 @@ def interpolate(base: dict, tuned: dict, alpha: float) -> dict:
     return out
 
 
+def with_look_ahead_of(base: dict, tuned: dict) -> dict:
+    """base as it is, or, where TUNED gained a look-ahead block in its fine-tune (frontend.train --ahead) that BASE
+    lacks, BASE with that block at zero: the same function (look_further), so the line between them is defined."""
+    from ..model.config import ModelConfig
+    b, t = (ModelConfig.from_dict(x["model_config"]) for x in (base, tuned))
+    if b.content_ahead == t.content_ahead or b.content_ahead:
+        return base
+    prefix = f"blocks.{len(ContentEncoder.DILATIONS)}."
+    extra = {k: torch.zeros_like(v) for k, v in tuned["content"].items() if k.startswith(prefix)}
+    if any(k in base["content"] for k in extra):
+        return base
+    return {**base, "content": {**base["content"], **extra},
+            "model_config": {**base["model_config"], "content_ahead": t.content_ahead}}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.soup", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -56,7 +72,8 @@ def main(argv=None) -> int:
     ap.add_argument("--face", help="write this face checkpoint with the result as its content encoder, not a front-end file")
     ap.add_argument("--out", required=True)
     args = ap.parse_args(argv)
-    base, tuned = load_frontend(args.base), load_frontend(args.tuned)
+    tuned = load_frontend(args.tuned)
+    base = with_look_ahead_of(load_frontend(args.base), tuned)
     try:
         content = interpolate(base, tuned, args.alpha)
     except ValueError as e:
@@ -67,9 +84,12 @@ def main(argv=None) -> int:
         if "model" not in payload:
             ap.error(f"--face: {args.face} is not a face checkpoint")
         model = payload["model"]
-        if any(model.get("content." + k) is None or model["content." + k].shape != v.shape for k, v in content.items()):
+        face = with_look_ahead_of({"content": {k[len("content."):]: v for k, v in model.items() if k.startswith("content.")},
+                                   "model_config": payload["model_config"]}, tuned)
+        if face["content"].keys() != content.keys() or any(face["content"][k].shape != v.shape for k, v in content.items()):
             ap.error(f"--face: the content encoder of {args.face} is not of the front-ends' architecture")
         payload["model"] = {**model, **{"content." + k: v for k, v in content.items()}}
+        payload["model_config"] = face["model_config"]
         payload["frontend_soup"] = made
     else:
         payload = {"content": content, "model_config": tuned["model_config"], "step": tuned.get("step", 0),

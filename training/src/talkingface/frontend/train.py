@@ -61,6 +61,19 @@ def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncode
     return wide
 
 
+def look_further(enc: ContentEncoder, cfg: ModelConfig) -> ContentEncoder:
+    """`enc` with the last block cfg.content_ahead adds (encoders.ContentEncoder), computing the same function: the block's
+    convolution starts at zero, so the residual passes everything through (gelu(0) = 0), and its gradient is not zero
+    (gelu'(0) = 1/2), so it learns what the frames ahead add."""
+    if len(getattr(enc, "blocks", ())) != len(ContentEncoder.DILATIONS):
+        raise ValueError("look_further: expected a dilated content encoder without a look-ahead block")
+    out = ContentEncoder(cfg, enc.norm.mean.numel())
+    extra = out.blocks[len(enc.blocks)].conv
+    state = enc.state_dict() | {f"blocks.{len(enc.blocks)}.conv.{k}": torch.zeros_like(v) for k, v in extra.state_dict().items()}
+    out.load_state_dict(state)
+    return out
+
+
 def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
     rows = [json.loads(l) for l in (folder / "index.jsonl").read_text().splitlines()]
     out = []
@@ -157,6 +170,10 @@ def main(argv=None) -> int:
     ap.add_argument("--channels", type=int, default=ModelConfig.content_channels,
                     help="the content encoder's width (default %(default)s); an --init front-end that is narrower is widened "
                          "to it, computing the same function at the start (widen)")
+    ap.add_argument("--ahead", type=int, default=0, metavar="FRAMES",
+                    help="a last residual block reading one tap FRAMES content frames (20 ms each) ahead: more look-ahead for "
+                         "the front-end, and as much more streaming latency (default 0: none). An --init front-end without it "
+                         "gets it computing the same function at the start (look_further)")
     ap.add_argument("--consistency", type=float, default=0.0, metavar="WEIGHT",
                     help="train on two views of each crop (two vocal-tract warps, two sets of masks) and add WEIGHT x the "
                          "symmetric KL divergence between their posteriors: hearing a phone the same whatever the voice's "
@@ -177,7 +194,7 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     log = lambda *a: print(*a, file=sys.stderr, flush=True)
 
-    cfg, audio = ModelConfig(content_channels=args.channels), AudioConfig()
+    cfg, audio = ModelConfig(content_channels=args.channels, content_ahead=args.ahead), AudioConfig()
     clips, held = read_args_speech(args, audio)
     bank = Bank.from_clips(clips, args.device)
     del clips
@@ -194,11 +211,18 @@ def main(argv=None) -> int:
         if any(init["model_config"][k] != v for k, v in arch.items()) or init_cfg.content_channels > args.channels:
             raise SystemExit(f"--init: {args.init} has another content encoder than {arch | {'content_channels': args.channels}} "
                              f"(it has {init_cfg.content_channels} channels)")
+        if init_cfg.content_ahead not in (0, args.ahead):
+            raise SystemExit(f"--init: {args.init} reads {init_cfg.content_ahead} content frames further ahead, not --ahead "
+                             f"{args.ahead}: a block's look-ahead cannot be changed without changing what it computes")
         narrow = ContentEncoder(init_cfg, audio.n_mels)
         narrow.load_state_dict(init["content"])
-        enc = widen(narrow, cfg, args.seed) if init_cfg.content_channels < args.channels else narrow
+        enc = widen(narrow, ModelConfig(**init_cfg.to_dict() | {"content_channels": args.channels}), args.seed) \
+            if init_cfg.content_channels < args.channels else narrow
+        if init_cfg.content_ahead != args.ahead:
+            enc = look_further(enc, cfg)
         log(f"initialised from {args.init} ({init['step']} steps" +
-            (f", widened from {init_cfg.content_channels} to {args.channels} channels)" if enc is not narrow else ")"))
+            (f", widened from {init_cfg.content_channels} to {args.channels} channels" if init_cfg.content_channels < args.channels else "") +
+            (f", with a last block reading {args.ahead} content frames ahead" if init_cfg.content_ahead != args.ahead else "") + ")")
     enc.to(args.device)
     class_weight = torch.ones(cfg.content_classes, device=args.device)
     class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight

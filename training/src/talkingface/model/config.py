@@ -23,6 +23,8 @@ class ModelConfig:
     content_arch: str = "dilated" # "dilated": residual dilated convolutions reading 550 ms back, 70 ms ahead (issue 14);
                                   # "conv4": the first encoder, four convolutions reading 70 ms each way
     content_channels: int = 128   # content encoder width
+    content_ahead: int = 0        # "dilated" only: 0, or a last residual block reading one tap this many content frames
+                                  # (20 ms each) ahead: the front-end's look-ahead, and the streaming latency, grow by as much
     template_input: bool = False  # vertex tokens also read how the subject's neutral face differs from the reference face
                                   # (encoders.HierarchicalFeature): how far lips must travel to close depends on the face;
                                   # only with the local feature (features L or LG)

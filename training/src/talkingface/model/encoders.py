@@ -60,10 +60,13 @@ class ContentEncoder(nn.Module):
                 nn.Conv1d(n_mels, C, 5, padding=2), nn.GELU(),
                 nn.Conv1d(C, C, 3, stride=cfg.content_stride, padding=1), nn.GELU(),
             )
-            self.blocks = nn.ModuleList(ShiftedConv(C, d, a) for d, a in self.DILATIONS)
+            extra = ((cfg.content_ahead, 1),) if cfg.content_ahead else ()
+            self.blocks = nn.ModuleList(ShiftedConv(C, d, a) for d, a in self.DILATIONS + extra)
             self.out = nn.Conv1d(C, cfg.content_classes, 1)
         else:
             raise ValueError(f"unknown content_arch {cfg.content_arch!r} (dilated, conv4)")
+        if cfg.content_ahead and cfg.content_arch != "dilated":
+            raise ValueError(f"content_ahead needs the dilated content encoder, not {cfg.content_arch!r}")
 
     def forward(self, mel: torch.Tensor) -> torch.Tensor:
         """(B, K, n_mels) -> (B, ceil(K / stride), classes) logits."""

@@ -104,6 +104,10 @@ def parse_args(argv=None) -> argparse.Namespace:
                     help="train with the closure retargeted to each face's own lip gap in the loss (model/lip_closure.py), "
                          "this reference gap in mm: the model learns how far to close, the face sets how far that is")
     ap.add_argument("--lip-weight", type=float, default=LossWeights.lips, help="weight of the lip reconstruction term (losses.py)")
+    ap.add_argument("--window-future", type=int, choices=range(0, 4), metavar="FRAMES",
+                    help=f"content frames (20 ms each) of the window after the animation frame (default "
+                         f"{ModelConfig.window_future}); with --init from a model of another, the window moves and the "
+                         "training re-learns it. Look-ahead in all: this, the front-end's and half a Mel frame (export.py)")
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
         ap.error("give exactly one of --minutes and --steps")
@@ -159,10 +163,11 @@ def main(argv=None) -> int:
     ds = open_dataset(args.corpus, args.template, args.masks)
     audio = AudioConfig(fps=int(ds.fps))
     frontend = load_frontend(args.frontend) if args.frontend else None
-    content_cfg = {k: frontend["model_config"][k] for k in ("content_arch", "content_channels", "content_classes", "content_stride")} \
-        if frontend else {}
+    content_keys = ("content_arch", "content_channels", "content_classes", "content_stride", "content_ahead")
+    content_cfg = {k: getattr(ModelConfig.from_dict(frontend["model_config"]), k) for k in content_keys} if frontend else {}
+    window = {"window_future": args.window_future} if args.window_future is not None else {}
     cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant,
-                      template_input="L" in args.features and args.template_input, **content_cfg)
+                      template_input="L" in args.features and args.template_input, **content_cfg, **window)
     t0 = time.time()
     clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
@@ -183,12 +188,18 @@ def main(argv=None) -> int:
         init = torch.load(args.init, map_location="cpu", weights_only=False)
         init_cfg = ModelConfig.from_dict(init["model_config"]).to_dict()
         gains_shape = not init_cfg["template_input"] and cfg.template_input  # a model without the shape input gains it, at zero
-        if init_cfg | ({"template_input": True} if gains_shape else {}) != cfg.to_dict():
+        # A --frontend replaces the content encoder, so the initial model's may differ from it (e.g. a look-ahead block).
+        free = (content_keys if frontend else ()) + tuple(window)
+        own = lambda d: {k: v for k, v in d.items() if k not in free}
+        if own(init_cfg | ({"template_input": True} if gains_shape else {})) != own(cfg.to_dict()):
             raise SystemExit(f"--init: {args.init} is a {init['model_config']} model, not {cfg.to_dict()}")
-        missing, unexpected = model.load_state_dict(init["model"], strict=not gains_shape)
-        if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference") for k in missing):
+        weights = {k: v for k, v in init["model"].items() if not (frontend and k.startswith("content."))}
+        missing, unexpected = model.load_state_dict(weights, strict=False)
+        replaced = lambda k: bool(frontend) and k.startswith("content.")
+        if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference" or replaced(k)) for k in missing):
             raise SystemExit(f"--init: {args.init} does not fit: missing {missing}, unexpected {unexpected}")
-        log(f"initialised from {args.init} (step {init['step']}){', the shape input added at zero' if gains_shape else ''}")
+        moved = f", its window moved to {cfg.window_future} frames ahead" if init_cfg["window_future"] != cfg.window_future else ""
+        log(f"initialised from {args.init} (step {init['step']}){', the shape input added at zero' if gains_shape else ''}{moved}")
     # After --init: the front-end replaces the content encoder the initial weights brought.
     if frontend:  # its own Mel normalisation (statistics of its far larger speech set) comes with it
         model.content.load_state_dict(frontend["content"])
