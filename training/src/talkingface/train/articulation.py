@@ -40,13 +40,17 @@ def segment_frames(start: float, end: float, fps: float, n_frames: int) -> np.nd
     return k if len(k) else np.array([int(np.clip(round(0.5 * (start + end) * fps), 0, n_frames - 1))])
 
 
+def speech_segments(gap: np.ndarray, phones, fps: float):
+    """(phone, start, end, the gap over the segment's frames) for every segment of speech (silence left out)."""
+    for p, a, b in phones:
+        if p != SILENCE:
+            yield p, a, b, gap[segment_frames(a, b, fps, len(gap))]
+
+
 def segment_counts(gap: np.ndarray, phones, fps: float) -> dict:
     """Counts of (hits, trials) for closure on bilabials, closure elsewhere in speech, and opening on open vowels."""
     c = {"bilabial_closed": 0, "bilabial": 0, "other_closed": 0, "other": 0, "open_vowel_opened": 0, "open_vowel": 0}
-    for p, a, b in phones:
-        if p == SILENCE:
-            continue
-        g = gap[segment_frames(a, b, fps, len(gap))]
+    for p, a, b, g in speech_segments(gap, phones, fps):
         if p in BILABIALS:
             c["bilabial"] += 1
             c["bilabial_closed"] += int(g.min() < CLOSED_MM)

@@ -60,10 +60,9 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         with torch.no_grad():
             heard = model.content(mel[None])[0]                               # (Kc, D): once, for the face and the tally
         decoded = phone_logits(c.phones, model.cfg.content_stride, model.cfg.content_classes) if oracle_phones else heard
-        out = model.animate(mel, torch.from_numpy(c.template), c.num_frames, logits=decoded)
-        pred_unposed, pred_pose, pred_posed = out["unposed"].numpy(), out["pose"].numpy(), out["vertices"].numpy()
+        pred_unposed, out = animate_unposed(model, c, closers, decoded)
+        pred_pose, pred_posed = out["pose"].numpy(), out["vertices"].numpy()
         if closers:
-            pred_unposed = c.template[None] + closers(c.template).apply(out["offsets"].numpy())
             pred_posed = apply_pose_np(pred_unposed, pred_pose)
         mel_index = frame_to_mel_index(np.arange(c.num_frames), model.audio)
         env = hm.envelope(c.mel, mel_index)
@@ -112,6 +111,16 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
             "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure, mouth_gain),
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
+
+
+def animate_unposed(model, c, closers: "lc.Closers | None", logits: torch.Tensor | None = None) -> tuple[np.ndarray, dict]:
+    """A prepared clip's unposed face (F, N, 3) in mm as the browser shows it: the lips closed by each face's own gap
+    when `closers` (model/lip_closure.py); and model.animate's whole output. `logits`: what the face decodes (None: what
+    its content encoder hears)."""
+    out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames, logits=logits)
+    if closers is None:
+        return out["unposed"].numpy(), out
+    return c.template[None] + closers(c.template).apply(out["offsets"].numpy()), out
 
 
 def draw_seed(seed: int, clip: int, draw: int) -> int:
