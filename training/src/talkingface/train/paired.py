@@ -80,16 +80,17 @@ def compare(first: dict[str, np.ndarray], second: dict[str, np.ndarray]) -> dict
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.train.paired", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--corpus", required=True)
     ap.add_argument("first", help="a face checkpoint (e.g. the shipped one)")
     ap.add_argument("second", help="the face checkpoint to compare with it")
-    ap.add_argument("--split", default="val", help="the split both are measured on (default val, which decides)")
+    ap.add_argument("--corpus", required=True, help="the dataset both were trained on")
+    ap.add_argument("--split", default="val", choices=("train", "val", "test"),
+                    help="the split both are measured on (default val, which decides)")
     ap.add_argument("--out", type=Path, help="also write the figures as JSON here")
     args = ap.parse_args(argv)
-    torch.set_num_threads(1)
     ds = open_dataset(args.corpus)
-    if args.split not in ("train", "val", "test") or not ds.keys(args.split):
+    if not ds.keys(args.split):
         ap.error(f"--split {args.split}: {args.corpus} has no clips in it")
+    torch.set_num_threads(1)
     flags = []
     for path in (args.first, args.second):
         model, ck = load_checkpoint(Path(path), ds.template)
