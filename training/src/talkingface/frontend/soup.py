@@ -50,17 +50,17 @@ def interpolate(base: dict, tuned: dict, alpha: float) -> dict:
 
 def with_look_ahead_of(base: dict, tuned: dict) -> dict:
     """base as it is, or, where TUNED gained a look-ahead block in its fine-tune (frontend.train --ahead) that BASE
-    lacks, BASE with that block at zero: the same function (look_further), so the line between them is defined."""
+    lacks, BASE with that block at zero: the same function (frontend.train.look_further), so the line between them
+    is defined."""
     from ..model.config import ModelConfig
+    from .train import look_further
     b, t = (ModelConfig.from_dict(x["model_config"]) for x in (base, tuned))
-    if b.content_ahead == t.content_ahead or b.content_ahead:
+    if b.content_ahead or not t.content_ahead:
         return base
-    prefix = f"blocks.{len(ContentEncoder.DILATIONS)}."
-    extra = {k: torch.zeros_like(v) for k, v in tuned["content"].items() if k.startswith(prefix)}
-    if any(k in base["content"] for k in extra):
-        return base
-    return {**base, "content": {**base["content"], **extra},
-            "model_config": {**base["model_config"], "content_ahead": t.content_ahead}}
+    enc = ContentEncoder(b, base["content"]["norm.mean"].numel())
+    enc.load_state_dict(base["content"])
+    cfg = ModelConfig(**b.to_dict() | {"content_ahead": t.content_ahead})
+    return {**base, "content": look_further(enc, cfg).state_dict(), "model_config": cfg.to_dict()}
 
 
 def main(argv=None) -> int:

@@ -22,6 +22,7 @@ from ..phones import BILABIALS, PHONES
 from . import articulation as art
 from ..model import lip_closure as lc
 from .data import prepare
+from .evaluate import animate_unposed
 from .train import load_checkpoint
 
 
@@ -34,11 +35,8 @@ def segments(model, ds, split: str, reference_gap: float | None = None, mouth_ga
     rows = []
     for key in ds.keys(split):
         c = prepare(ds, key, model.audio)
-        out = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)
-        offsets = out["offsets"].numpy()
-        if closers:
-            offsets = closers(c.template).apply(offsets)
-        gap = art.inner_lip_gap(c.template[None] + offsets, ds.template)
+        unposed, out = animate_unposed(model, c, closers)
+        gap = art.inner_lip_gap(unposed, ds.template)
         face_gap = float(art.inner_lip_gap(c.template[None], ds.template)[0])
         post = out["logits"].softmax(-1).numpy()
         for p, a, b in c.segments:
