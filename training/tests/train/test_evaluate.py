@@ -1,4 +1,6 @@
 """Evaluation of a trained model on the small corpus's test split: the paper's metrics for every clip."""
+import numpy as np
+
 from talkingface.train import evaluate, train
 
 
@@ -31,13 +33,19 @@ def test_oracle_phones_are_what_the_face_decodes(corpus, trained_run):
     assert not np.allclose(model.animate(mel, tpl, c.num_frames, logits=oracle)["offsets"].numpy(), heard.numpy(), atol=1e-3)
 
 
-def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, trained_run, tmp_path):
+def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, trained_run, tmp_path, capsys):
     import pytest
     import torch
     from talkingface.model import head_motion
     fitted, cache = tmp_path / "hm.pt", tmp_path / "hm.npz"
     base = ["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--out", str(fitted), "--cache", str(cache)]
     assert head_motion.main(base + ["--against-mean"]) == 0
+    # the cache keeps each clip's source, and the fit says the spread ratio of each source's clips
+    sources = np.load(cache)["sources"].tolist()
+    assert len(sources) == int(np.load(cache)["clips"]) and set(sources) <= {"tts", "human", "real"}
+    printed = capsys.readouterr().out
+    for name in set(sources):
+        assert f"{name} clips ({sources.count(name)}): spread truth" in printed
     fit = torch.load(fitted, weights_only=False)["head_motion_fit"]
     assert fit == {"split": "train", "against_mean": True, "ridge": head_motion.SPEECH_RIDGE, "gain": "geometric mean over speakers"}
     with pytest.raises(SystemExit, match="against-mean"):  # residuals from the mean pose are not the neutral pose's

@@ -182,8 +182,10 @@ def clip_features(model, mel: np.ndarray, n_frames: int) -> tuple[np.ndarray, np
     return feat[0, idx].numpy(), idx
 
 
-def collect(model, ds, split: str = "train", progress=None, against_mean: bool = False) -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
-    """Per clip of the split: the residual rotations (degrees), the pose-token features and the speaker. The residual is the
+def collect(model, ds, split: str = "train", progress=None, against_mean: bool = False,
+            sources: list[str] | None = None) -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
+    """Per clip of the split: the residual rotations (degrees), the pose-token features and the speaker (and each
+    clip's source, "tts" or "human", appended to `sources` when given). The residual is the
     truth's rotation itself by default (the pose head's mean moves the head by about a tenth of the truth, so the
     two differ little, and this needs only the pose encoder: minutes instead of an hour on two cores);
     `against_mean`: the rotation from the model's mean pose to the truth (the whole model runs on every clip)."""
@@ -202,6 +204,8 @@ def collect(model, ds, split: str = "train", progress=None, against_mean: bool =
             residuals.append(residual_of(c.pose, mean))
             feats.append(f)
             speakers.append(ds.subject_of(key))
+            if sources is not None:
+                sources.append(c.source)
         if progress:
             progress(i + 1, len(keys))
     return residuals, feats, speakers
@@ -292,10 +296,13 @@ def main(argv=None) -> int:
                              "delete it or give another --cache")
         n = int(data["clips"])
         residuals, feats, speakers = [data[f"r{i}"] for i in range(n)], [data[f"f{i}"] for i in range(n)], data["speakers"].tolist()
+        sources = data["sources"].tolist() if "sources" in data else []  # a cache from before they were kept has none
     else:
-        residuals, feats, speakers = collect(model, ds, "train", progress, args.against_mean)
+        sources = []
+        residuals, feats, speakers = collect(model, ds, "train", progress, args.against_mean, sources)
         if args.cache:
-            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), **{f"r{i}": r for i, r in enumerate(residuals)},
+            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), sources=np.array(sources),
+                     **{f"r{i}": r for i, r in enumerate(residuals)},
                      against_mean=args.against_mean, **{f"f{i}": f for i, f in enumerate(feats)})
     from ..corpus.clip import neck_pivot
     template_mm = ds.template.vertices.astype(np.float64) * ds.mm_per_unit
@@ -317,6 +324,11 @@ def main(argv=None) -> int:
     for g in sorted(set(speakers)):
         t, m = (motion_stats([x for x, s in zip(xs, group) if s == g])["spread"] for xs in (residuals, drawn))
         print(f"  {g}: spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
+    # Recorded speech against the synthetic voices on the same faces: whether the model moves the head more or less,
+    # for the speech it hears, than the truth does (the spread ratio, each source's clips together).
+    for name in sorted(set(sources)):
+        t, m = (motion_stats([x for x, s in zip(xs, sources) if s == name])["spread"] for xs in (residuals, drawn))
+        print(f"  {name} clips ({sources.count(name)}): spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
     ck["head_motion"] = hm.to_dict()
     ck["head_motion_fit"] = {"split": "train", "against_mean": args.against_mean, "ridge": None if args.no_speech else args.ridge,
                              "gain": "mean over clips" if args.per_clip else "geometric mean over speakers"}  # evaluate says it
