@@ -121,7 +121,8 @@ def test_the_vocoder_keeps_the_words_and_replaces_the_source():
 
 @pytest.mark.parametrize("module, voices, option, engine", [
     ("more_voices", ["rhvoice:bdl", "pico:en-GB"], "more_share", "more"),
-    ("diphone_voices", ["festival:rab", "festival:us1"], "diphone_share", "diphone")])
+    ("diphone_voices", ["festival:rab", "festival:us1"], "diphone_share", "diphone"),
+    ("mbrola_voices", ["mbrola:de4", "mbrola:fr2"], "mbrola_share", "mbrola")])
 def test_a_voices_option_gives_synthetic_clips_to_its_voices_and_leaves_the_rest(monkeypatch, module, voices, option, engine):
     import importlib
     voice_module = importlib.import_module(f"talkingface.corpus.{module}")

@@ -1,6 +1,6 @@
 """Command line for the synthetic corpus.
 
-  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]] [--foreign-voices] [--more-voices] [--diphone-voices]   install the Debian speech tools (apt) [and Kokoro's voices]
+  scripts/py -m talkingface.corpus setup [--kokoro [--kokoro-accented]] [--foreign-voices] [--more-voices] [--diphone-voices] [--mbrola-voices]   install the Debian speech tools (apt) [and Kokoro's voices]
   scripts/py -m talkingface.corpus build --preset small --out data/corpus-small
   scripts/py -m talkingface.corpus build --preset full  --out data/corpus --workers 2
   scripts/py -m talkingface.corpus card  --corpus data/corpus --out docs/corpus
@@ -54,6 +54,10 @@ def cmd_setup(args) -> int:
         from . import diphone_voices
         diphone_voices.setup()
         print(f"diphone voices: {' '.join(diphone_voices.available())}")
+    if args.mbrola_voices:  # MBROLA's voices of other languages, from Debian's non-free section (corpus/mbrola_voices.py)
+        from . import mbrola_voices
+        mbrola_voices.setup()
+        print(f"MBROLA voices: {' '.join(mbrola_voices.available())}")
     from .foreign import FOREIGN_PACKAGES
     wanted = DEBIAN_PACKAGES + (FOREIGN_PACKAGES if args.foreign_voices else ())
     missing = [p for p in wanted if not installed(p)]
@@ -114,6 +118,8 @@ def main(argv=None) -> int:
                     help="and RHVoice's and SVOX Pico's English voices, from Debian's contrib and non-free sections (corpus/more_voices.py)")
     st.add_argument("--diphone-voices", action="store_true",
                     help="and festival's rab and don and MBROLA's us1, us2, us3 and en1 (corpus/diphone_voices.py)")
+    st.add_argument("--mbrola-voices", action="store_true",
+                    help="and MBROLA's voices of other languages, about 70 Debian packages (corpus/mbrola_voices.py)")
     st.set_defaults(fn=cmd_setup)
     b = sub.add_parser("build", help="build a corpus")
     b.add_argument("--preset", choices=sorted(PRESETS), default="small")

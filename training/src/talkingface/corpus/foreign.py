@@ -92,12 +92,18 @@ def available() -> list[str]:
     return [n for n in FOREIGN_VOICES if n in have]
 
 
-def segments(phones: list[tuple[str, float, float]], voice: ForeignVoice, speed: float, rng: np.random.Generator
+VOWEL_STARTS = "aeiouyE@7O"  # the first letters of the vowels of PHONE_MAPS
+
+
+def segments(phones: list[tuple[str, float, float]], voice: ForeignVoice, speed: float, rng: np.random.Generator,
+             table: dict[str, str] | None = None, vowel_starts: str = VOWEL_STARTS
              ) -> tuple[list[tuple[str, float, list[tuple[float, float]]]], list[int]]:
     """English phones with times -> the voice's segments (name, duration s, F0 targets (time in segment, Hz)) and,
     per segment, the index of the English phone it says. An English phone the language lacks (an empty map) is
-    said by its neighbour: its time goes to the next phone's first segment (or the previous one at the end)."""
-    table = PHONE_MAPS[voice.language]
+    said by its neighbour: its time goes to the next phone's first segment (or the previous one at the end).
+    `table`: English phone -> the voice's phones (space-separated), PHONE_MAPS[voice.language] unless given;
+    a segment whose name starts with one of `vowel_starts` is a vowel and carries the intonation."""
+    table = PHONE_MAPS[voice.language] if table is None else table
     total = sum(b - a for _, a, b in phones) / speed
     base = voice.f0 * rng.uniform(0.85, 1.15)
     segs: list[list] = []
@@ -114,7 +120,7 @@ def segments(phones: list[tuple[str, float, float]], voice: ForeignVoice, speed:
         for k, n in enumerate(names):
             d = dur / len(names)
             targets = []
-            if n[0] in "aeiouyE@7O":  # a vowel: the intonation's line at its middle, accented on some
+            if n[0] in vowel_starts:  # a vowel: the intonation's line at its middle, accented on some
                 line = base * (1.15 - 0.3 * (t + d / 2) / max(total, 1e-6))
                 targets = [(round(d / 2, 4), round(line * (1.18 if rng.random() < 0.35 else 1.0), 1))]
             segs.append([n, d, targets])

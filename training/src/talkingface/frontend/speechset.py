@@ -14,7 +14,9 @@ front-end trains apart from the face, on this set:
   older synthesisers' kind, which the front-end hears worst;
 - with `--more-voices SHARE`, that share of the synthetic clips said by RHVoice's and SVOX Pico's English voices
   (corpus/more_voices.py): two more synthesiser families; with `--diphone-voices SHARE`, that share given to festival's
-  rab and don and MBROLA's us1, us2, us3 and en1 (corpus/diphone_voices.py): six more diphone voices;
+  rab and don and MBROLA's us1, us2, us3 and en1 (corpus/diphone_voices.py): six more diphone voices; with
+  `--mbrola-voices SHARE`, that share given to MBROLA's voices of other languages saying the English phones
+  (corpus/mbrola_voices.py): about forty more real speakers, men and women;
 - the recorded human speech of the corpus's train split (one speaker, real microphones).
 
 Phone labels: the synthesiser's own timings (festival, flite) or pocketsphinx forced alignment (the rest).
@@ -40,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..corpus import diphone_voices, foreign, kokoro, more_voices, recorded
+from ..corpus import diphone_voices, foreign, kokoro, mbrola_voices, more_voices, recorded
 from ..corpus.align import AlignmentError, Aligner
 from ..corpus.augment import augment_channel, augment_speech, vocode
 from ..corpus.plan import PRESETS, is_test_voice, split_of_recording
@@ -57,7 +59,7 @@ SHARES = {"kokoro": 0.6, "classic": 0.25, "human": 0.15}  # of the clips; the hu
 @dataclass
 class SpeechSpec:
     key: str
-    engine: str          # "kokoro", "festival", "flite", "espeak", "foreign" or "human"
+    engine: str          # "kokoro", "festival", "flite", "espeak", "foreign", "more", "diphone", "mbrola" or "human"
     voice: str           # voice name, a Kokoro blend "a*0.7+b", or the recording's name
     text: str
     speed: float
@@ -91,7 +93,7 @@ EXTRAPOLATE = (1.2, 1.8)
 
 def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_share: float = 0.0,
          accent_share: float = 0.0, extrapolate_share: float = 0.0, more_share: float = 0.0,
-         diphone_share: float = 0.0) -> list[SpeechSpec]:
+         diphone_share: float = 0.0, mbrola_share: float = 0.0) -> list[SpeechSpec]:
     """`kokoro_voices`: Kokoro's 28 English voices, its 26 accented ones (corpus/kokoro.py), or all 54.
     `foreign_share`: the share of the synthetic clips given instead to festival's foreign voices (corpus/foreign.py;
     the recorded speech stays), drawn from a generator of their own, so with 0 the plan is the one made before the
@@ -100,7 +102,9 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
     Kokoro's clips whose voice is one beyond two of them ("a*w+b" with w > 1, EXTRAPOLATE), its generator its own.
     `more_share`: the share of the synthetic clips given to RHVoice's and Pico's voices (corpus/more_voices.py), drawn
     after the foreign voices, from a generator of its own. `diphone_share`: the share of the synthetic clips given to
-    festival's and MBROLA's diphone voices (corpus/diphone_voices.py), drawn last, from a generator of its own."""
+    festival's and MBROLA's diphone voices (corpus/diphone_voices.py), from a generator of its own. `mbrola_share`: the
+    share of the synthetic clips given to MBROLA's voices of other languages (corpus/mbrola_voices.py), drawn last,
+    from a generator of its own."""
     rng = np.random.default_rng(seed)
     n = int(minutes * 60 / 3.0)  # clips average about 3 s
     pool = texts(max(n, 400), seed)
@@ -124,6 +128,10 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
     diphones = diphone_voices.available() if diphone_share > 0 else []
     if diphone_share > 0 and not diphones:
         raise foreign.SpeechToolError(f"festival's and MBROLA's diphone voices are not installed: run `{diphone_voices.SETUP}`")
+    brng = np.random.default_rng([seed, 7])
+    mbrolas = mbrola_voices.available() if mbrola_share > 0 else []
+    if mbrola_share > 0 and not mbrolas:
+        raise foreign.SpeechToolError(f"MBROLA's voices of other languages are not installed: run `{mbrola_voices.SETUP}`")
     humans = [r for r in recorded.recordings() if split_of_recording(r.name) == "train"] if recorded.available() else []
     specs = []
     for i in range(n):
@@ -161,6 +169,10 @@ def plan(minutes: float, seed: int, kokoro_voices: str = "english", foreign_shar
             given, voice, speed = drng.random() < diphone_share, diphones[drng.integers(len(diphones))], drng.uniform(0.85, 1.15)
             if given and specs[-1].engine != "human":
                 specs[-1] = SpeechSpec(key, "diphone", voice, text, float(speed), clip_seed)
+        if mbrolas:  # drawn for every clip, as the diphone voices
+            given, voice, speed = brng.random() < mbrola_share, mbrolas[brng.integers(len(mbrolas))], brng.uniform(0.85, 1.15)
+            if given and specs[-1].engine != "human":
+                specs[-1] = SpeechSpec(key, "mbrola", voice, text, float(speed), clip_seed)
     return specs
 
 
@@ -183,6 +195,8 @@ def speak(spec: SpeechSpec, sr: int) -> tuple[np.ndarray, list]:
         audio, phones = more_voices.synthesize(spec.voice, spec.text, sr), None
     elif spec.engine == "diphone":
         audio, phones = diphone_voices.synthesize(spec.voice, spec.text, sr, spec.speed), None
+    elif spec.engine == "mbrola":
+        audio, phones = mbrola_voices.synthesize_mbrola(spec.voice, spec.text, sr, spec.speed, spec.seed)
     elif spec.engine == "kokoro":
         audio = resample(kokoro.synthesize(spec.voice, spec.text, spec.speed), kokoro.KOKORO_RATE, sr)
         audio = np.concatenate([np.zeros(int(0.2 * sr), np.float32), audio, np.zeros(int(0.2 * sr), np.float32)])
@@ -219,15 +233,17 @@ def build_one(args) -> dict:
 
 def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str = "english", first: int | None = None,
           vocode_share: float = 0.0, foreign_share: float = 0.0, accent_share: float = 0.0, extrapolate_share: float = 0.0,
-          more_share: float = 0.0, diphone_share: float = 0.0) -> dict:
+          more_share: float = 0.0, diphone_share: float = 0.0, mbrola_share: float = 0.0) -> dict:
     """`first`: build only the plan's first clips (a set that was stopped, rebuilt exactly). `vocode_share`: the share of
     clips said through a vocoder first (corpus/augment.py, vocode), as older synthesisers' voices sound. `foreign_share`:
     the share of the synthetic clips said by festival's foreign voices (plan, corpus/foreign.py). `accent_share`: the share
     of Kokoro's clips said with an espeak-ng accent (plan). `extrapolate_share`: the share of Kokoro's clips said by a
     voice beyond two of its voices (plan). `more_share`: the share of the synthetic clips said by RHVoice's and Pico's voices.
-    `diphone_share`: the share of the synthetic clips said by festival's and MBROLA's diphone voices (plan)."""
+    `diphone_share`: the share of the synthetic clips said by festival's and MBROLA's diphone voices (plan).
+    `mbrola_share`: the share of the synthetic clips said by MBROLA's voices of other languages (plan)."""
     out.mkdir(parents=True, exist_ok=True)
-    specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share, extrapolate_share, more_share, diphone_share)[:first]
+    specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share, extrapolate_share, more_share, diphone_share,
+                 mbrola_share)[:first]
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
@@ -271,7 +287,9 @@ def main(argv=None) -> int:
         "more_voices": "give this share of the synthetic clips to RHVoice's and SVOX Pico's English voices "
                        "(setup --more-voices; corpus/more_voices.py)",
         "diphone_voices": "give this share of the synthetic clips to festival's rab and don and MBROLA's us1, us2, us3 "
-                          "and en1 (setup --diphone-voices; corpus/diphone_voices.py)"}
+                          "and en1 (setup --diphone-voices; corpus/diphone_voices.py)",
+        "mbrola_voices": "give this share of the synthetic clips to MBROLA's voices of other languages saying the English "
+                         "phones (setup --mbrola-voices; corpus/mbrola_voices.py)"}
     for name, text in shares.items():
         ap.add_argument(f"--{name.replace('_', '-')}", type=float, default=0.0, metavar="SHARE", help=f"{text} (default 0)")
     args = ap.parse_args(argv)
@@ -279,7 +297,7 @@ def main(argv=None) -> int:
         if not 0.0 <= getattr(args, name) <= 1.0:
             ap.error(f"--{name.replace('_', '-')} is a share of the clips, from 0 to 1 (got {getattr(args, name)})")
     meta = build(args.out, args.minutes, args.seed, args.workers, args.kokoro_voices, args.first, args.vocode, args.foreign, args.accents,
-                 args.extrapolate, args.more_voices, args.diphone_voices)
+                 args.extrapolate, args.more_voices, args.diphone_voices, args.mbrola_voices)
     print(f"done: {meta['clips']} clips ({meta['skipped']} skipped), {meta['minutes']} min, {meta['voices']} voices -> {args.out}")
     return 0
 
