@@ -45,7 +45,7 @@ def test_the_head_motion_fit_is_recorded_and_its_cache_must_match(corpus, traine
     assert len(sources) == int(np.load(cache)["clips"]) and set(sources) <= {"tts", "human", "real"}
     printed = capsys.readouterr().out
     for name in set(sources):
-        assert f"{name} clips ({sources.count(name)}): spread truth" in printed
+        assert f"{name} ({sources.count(name)} clips): spread truth" in printed
     fit = torch.load(fitted, weights_only=False)["head_motion_fit"]
     assert fit == {"split": "train", "against_mean": True, "ridge": head_motion.SPEECH_RIDGE, "gain": "geometric mean over speakers"}
     with pytest.raises(SystemExit, match="against-mean"):  # residuals from the mean pose are not the neutral pose's

@@ -182,33 +182,28 @@ def clip_features(model, mel: np.ndarray, n_frames: int) -> tuple[np.ndarray, np
     return feat[0, idx].numpy(), idx
 
 
-def collect(model, ds, split: str = "train", progress=None, against_mean: bool = False,
-            sources: list[str] | None = None) -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
-    """Per clip of the split: the residual rotations (degrees), the pose-token features and the speaker (and each
-    clip's source, "tts" or "human", appended to `sources` when given). The residual is the
-    truth's rotation itself by default (the pose head's mean moves the head by about a tenth of the truth, so the
-    two differ little, and this needs only the pose encoder: minutes instead of an hour on two cores);
-    `against_mean`: the rotation from the model's mean pose to the truth (the whole model runs on every clip)."""
+def collect(model, ds, split: str = "train", progress=None, against_mean: bool = False) -> tuple[list, list, list[str], list[str]]:
+    """Per clip of the split: the residual rotations (degrees), the pose-token features, the speaker and the source
+    ("tts" or "human"). The residual is the truth's rotation itself by default (the pose
+    head's mean moves the head by about a tenth of the truth, so the two differ little, and this needs only the pose
+    encoder); `against_mean`: the rotation from the model's mean pose to the truth (the whole model on every clip)."""
     import torch
     from ..train.data import prepare
-    residuals, feats, speakers = [], [], []
+    residuals, feats, speakers, sources = [], [], [], []
     keys = ds.keys(split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
         f, _ = clip_features(model, c.mel, c.num_frames)
-        if against_mean:
-            mean = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)["pose"].numpy()
-        else:
-            mean = np.zeros_like(c.pose)
+        mean = model.animate(torch.from_numpy(c.mel), torch.from_numpy(c.template), c.num_frames)["pose"].numpy() \
+            if against_mean else np.zeros_like(c.pose)
         if c.num_frames >= 8:
             residuals.append(residual_of(c.pose, mean))
             feats.append(f)
             speakers.append(ds.subject_of(key))
-            if sources is not None:
-                sources.append(c.source)
+            sources.append(c.source)
         if progress:
             progress(i + 1, len(keys))
-    return residuals, feats, speakers
+    return residuals, feats, speakers, sources
 
 
 def fit_speech(residuals: list[np.ndarray], feats: list[np.ndarray], ridge: float = SPEECH_RIDGE) -> tuple[np.ndarray, np.ndarray]:
@@ -298,12 +293,10 @@ def main(argv=None) -> int:
         residuals, feats, speakers = [data[f"r{i}"] for i in range(n)], [data[f"f{i}"] for i in range(n)], data["speakers"].tolist()
         sources = data["sources"].tolist() if "sources" in data else []  # a cache from before they were kept has none
     else:
-        sources = []
-        residuals, feats, speakers = collect(model, ds, "train", progress, args.against_mean, sources)
+        residuals, feats, speakers, sources = collect(model, ds, "train", progress, args.against_mean)
         if args.cache:
-            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), sources=np.array(sources),
-                     **{f"r{i}": r for i, r in enumerate(residuals)},
-                     against_mean=args.against_mean, **{f"f{i}": f for i, f in enumerate(feats)})
+            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), sources=np.array(sources), against_mean=args.against_mean,
+                     **{f"r{i}": r for i, r in enumerate(residuals)}, **{f"f{i}": f for i, f in enumerate(feats)})
     from ..corpus.clip import neck_pivot
     template_mm = ds.template.vertices.astype(np.float64) * ds.mm_per_unit
     hm = fit(residuals, feats, neck_pivot(template_mm, ds.template), None if args.no_speech else args.ridge,
@@ -315,20 +308,15 @@ def main(argv=None) -> int:
     print("AR(2) per axis (pitch, yaw, roll):", np.round(hm.ar, 4).tolist())
     print("gain:", np.round(hm.gain, 3).tolist(), " mean step (deg):", np.round(hm.sigma_mean, 4).tolist(),
           " stationary spread (deg):", np.round(hm.sigma_mean * sd, 3).tolist())
-    # What the fit gives on the clips it was fitted to (clip i drawn with seed i), in all and per speaker: the
-    # speakers move by different amounts that the audio does not carry, which the per-speaker ratios show.
+    # What the fit gives on the clips it was fitted to (clip i drawn with seed i): in all, per speaker (speakers move by
+    # different amounts that the audio does not carry) and per source (recorded speech against synthetic, same faces).
     drawn = [hm.sample(f, i) for i, f in enumerate(feats)]
     fmt = lambda st: " ".join(f"{k} {v:.3f}" for k, v in st.items())
     print(f"train split, truth: {fmt(motion_stats(residuals))}\n             model: {fmt(motion_stats(drawn))}")
-    group = np.asarray(speakers)
-    for g in sorted(set(speakers)):
-        t, m = (motion_stats([x for x, s in zip(xs, group) if s == g])["spread"] for xs in (residuals, drawn))
-        print(f"  {g}: spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
-    # Recorded speech against the synthetic voices on the same faces: whether the model moves the head more or less,
-    # for the speech it hears, than the truth does (the spread ratio, each source's clips together).
-    for name in sorted(set(sources)):
-        t, m = (motion_stats([x for x, s in zip(xs, sources) if s == name])["spread"] for xs in (residuals, drawn))
-        print(f"  {name} clips ({sources.count(name)}): spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
+    for names in (speakers, sources):
+        for g in sorted(set(names)):
+            t, m = (motion_stats([x for x, s in zip(xs, names) if s == g])["spread"] for xs in (residuals, drawn))
+            print(f"  {g} ({names.count(g)} clips): spread truth {t:.2f}, model {m:.2f} (ratio {m / t:.2f})")
     ck["head_motion"] = hm.to_dict()
     ck["head_motion_fit"] = {"split": "train", "against_mean": args.against_mean, "ridge": None if args.no_speech else args.ridge,
                              "gain": "mean over clips" if args.per_clip else "geometric mean over speakers"}  # evaluate says it
