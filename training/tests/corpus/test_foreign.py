@@ -59,3 +59,13 @@ def test_a_foreign_voice_says_the_sentence_with_english_labels_and_festivals_tim
     assert len(audio) == pytest.approx(phones[-1][2] * 16000, abs=2)
     voiced = audio[int(phones[1][1] * 16000): int(phones[-2][2] * 16000)]
     assert np.sqrt(np.mean(voiced ** 2)) > 0.01  # it spoke
+
+
+def test_english_phones_end_where_their_last_segment_ends_and_missing_bilabial_diphones_refuse():
+    english = [("SIL", 0.0, 0.2), ("AY", 0.2, 0.4), ("B", 0.4, 0.5)]
+    assert foreign.english_spans(english, [0, 1, 1, 2], [0.2, 0.3, 0.42, 0.5]) == [("SIL", 0.0, 0.2), ("AY", 0.2, 0.42), ("B", 0.42, 0.5)]
+    foreign.refuse_missing("v", [("a", "i")], foreign.PHONE_MAPS["it"])             # one, away from /p b m/: kept
+    with pytest.raises(foreign.SpeechToolError, match="lacks diphones"):
+        foreign.refuse_missing("v", [("a", "b")], foreign.PHONE_MAPS["it"])
+    with pytest.raises(foreign.SpeechToolError, match="lacks diphones"):
+        foreign.refuse_missing("v", [("a", "i")] * (foreign.MAX_MISSING + 1), foreign.PHONE_MAPS["it"])

@@ -163,15 +163,28 @@ def synthesize_foreign(name: str, text: str, sample_rate: int, speed: float = 1.
         said = [ln.split() for ln in seg_file.read_text().splitlines()]
         ends = [float(x[0]) for x in said if len(x) == 3 and x[0] != "#"]
         audio, sr = read_wav(wav)
-    bil = {p for e in BILABIALS for p in PHONE_MAPS[voice.language][e].split()}
-    if len(missing) > MAX_MISSING or any(a in bil or b in bil for a, b in missing):
-        raise SpeechToolError(f"voice {name} lacks diphones {missing[:4]} for this sentence")
+    refuse_missing(name, missing, PHONE_MAPS[voice.language])
     if len(ends) != len(segs):
         raise SpeechToolError(f"festival said {len(ends)} segments of {len(segs)}")
+    phones = english_spans(english, owner, ends)
+    audio = resample(audio, sr, sample_rate)[: int(round(phones[-1][2] * sample_rate))]
+    return audio, phones
+
+
+def refuse_missing(name: str, missing: list[tuple[str, str]], table: dict[str, str]) -> None:
+    """SpeechToolError if the diphones voice `name` lacked in a sentence touch a bilabial (as `table` says them) or
+    are more than MAX_MISSING."""
+    bil = {p for e in BILABIALS for p in table[e].split()}
+    if len(missing) > MAX_MISSING or any(a in bil or b in bil for a, b in missing):
+        raise SpeechToolError(f"voice {name} lacks diphones {missing[:4]} for this sentence")
+
+
+def english_spans(english: list[tuple[str, float, float]], owner: list[int], ends: list[float]) -> list[tuple[str, float, float]]:
+    """The English phones with the times they were said: segment j, ending at ends[j], says English phone owner[j],
+    and an English phone ends where its last segment ends."""
     phones, start = [], 0.0
-    for j, end in enumerate(ends):  # an English phone ends where its last segment ends
+    for j, end in enumerate(ends):
         if j + 1 == len(ends) or owner[j + 1] != owner[j]:
             phones.append((english[owner[j]][0], start, end))
             start = end
-    audio = resample(audio, sr, sample_rate)[: int(round(phones[-1][2] * sample_rate))]
-    return audio, phones
+    return phones

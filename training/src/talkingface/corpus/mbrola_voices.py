@@ -31,7 +31,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..phones import BILABIALS
 from ..wav import read_wav, resample
 from . import foreign, more_voices
 from .speech import SpeechToolError, Voice, synthesize
@@ -162,11 +161,9 @@ def synthesize_mbrola(name: str, text: str, sample_rate: int, speed: float = 1.0
         raise SpeechToolError(f"MBROLA voice {voice} lacks /p b m/ or a basic vowel as SAMPA phones: not used")
     _, english = synthesize(Voice("festival", "kal"), text, sample_rate)  # the English phones and their durations
     rng = np.random.default_rng(seed)
-    f0 = (200.0 if voice in FEMALE else 110.0)
-    spec = foreign.ForeignVoice(voice, "mbrola", "_", f0)
+    spec = foreign.ForeignVoice(voice, "mbrola", "_", 200.0 if voice in FEMALE else 110.0)
     segs, owner = foreign.segments(english, spec, speed, rng, phone_table(voice), VOWEL_STARTS)
     segs = [(n, max(int(round(1000 * d)), 10), tg) for n, d, tg in segs]   # whole milliseconds, as MBROLA reads them
-    bil = {p for e in BILABIALS for p in phone_table(voice)[e].split()}
     with tempfile.TemporaryDirectory(prefix="mbrola-x-") as tmp:
         wav = Path(tmp) / "out.wav"
         missing = MISSING.findall(_say(voice, _pho(segs), wav))
@@ -174,14 +171,7 @@ def synthesize_mbrola(name: str, text: str, sample_rate: int, speed: float = 1.0
             segs, owner = _break_pairs(segs, owner, set(missing))
             missing = MISSING.findall(_say(voice, _pho(segs), wav))
         audio, sr = read_wav(wav)
-    durations = [ms for _, ms, _ in segs]
-    if len(missing) > foreign.MAX_MISSING or any(a in bil or b in bil for a, b in missing):
-        raise SpeechToolError(f"voice {voice} lacks diphones {missing[:4]} for this sentence")
-    phones, start, t = [], 0.0, 0.0
-    for j, ms in enumerate(durations):  # an English phone ends where its last segment ends
-        t += ms / 1000.0
-        if j + 1 == len(durations) or owner[j + 1] != owner[j]:
-            phones.append((english[owner[j]][0], start, t))
-            start = t
+    foreign.refuse_missing(voice, missing, phone_table(voice))
+    phones = foreign.english_spans(english, owner, (np.cumsum([ms for _, ms, _ in segs]) / 1000.0).tolist())
     audio = resample(audio, sr, sample_rate)[: int(round(phones[-1][2] * sample_rate))]
     return audio.astype(np.float32), phones
