@@ -79,9 +79,9 @@ def test_timbre_changes_the_chosen_crops_smoothly_across_bands(monkeypatch):
 def test_pack_round_trip(tmp_path):
     rng = np.random.default_rng(4)
     train, val = toy_clips(rng), toy_clips(rng, (30, 40))
-    counts = fb.pack(tmp_path / "b.npz", train, {"val": val, "test": val[:1]})
+    counts = fb.pack(tmp_path / "new" / "b.npz", train, {"val": val, "test": val[:1]})  # its folder made for it
     assert counts == {"train": 3, "val": 2, "test": 1}
-    back = fb.unpack(tmp_path / "b.npz")
+    back = fb.unpack(tmp_path / "new" / "b.npz")
     lo, hi = np.percentile(np.concatenate([m for m, _ in train]), 0.01), max(m.max() for m, _ in train)
     for name, clips in (("train", train), ("val", val)):
         assert len(back[name]) == len(clips)

@@ -145,3 +145,26 @@ def test_view_disagreement_is_zero_for_the_same_posteriors_only():
     b = a.clone()
     b[:, 5:] = torch.randn(3, 5, 40)
     assert fe_train.view_disagreement(torch.cat([a, b]), real).abs() < 1e-6
+
+
+def test_a_clip_several_speech_sets_hold_is_read_once(tmp_path):
+    def speech_set(name, rows):
+        folder = tmp_path / name
+        folder.mkdir()
+        for i, r in enumerate(rows):
+            np.savez(folder / f"{r['key']}.npz", mel=np.full((5, 80), i, np.float32), labels=np.zeros(5, np.int8))
+        (folder / "index.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+        return folder
+
+    shared = {"key": "s00000", "voice": "a", "text": "Bob", "seed": 1}
+    first = speech_set("first", [shared, {"key": "s00001", "voice": "b", "text": "Pam", "seed": 2}])
+    # the same key with another voice is another clip; the row itself (keys in any order) is the same clip
+    second = speech_set("second", [dict(reversed(list(shared.items()))), {"key": "s00001", "voice": "c", "text": "Pam", "seed": 2},
+                                   {"key": "s00002", "skipped": "no bilabial diphone"}])
+    assert len(fe_train.load_speech(second)) == 2  # alone, as before
+    seen: set[str] = set()
+    assert len(fe_train.load_speech(first, seen)) == 2
+    kept = fe_train.load_speech(second, seen)
+    assert [m[0, 0] for m, _ in kept] == [1.0]  # only the new voice's clip
+    with pytest.raises(SystemExit, match="no clips"):
+        fe_train.load_speech(speech_set("empty", [{"key": "s00000", "skipped": "x"}]), seen)

@@ -152,6 +152,7 @@ def pack(out: Path, train: list[tuple[np.ndarray, np.ndarray]], held: dict[str, 
         arrays[f"{name}_mel"] = quantise(np.concatenate([m for m, _ in clips]), lo, hi)
         arrays[f"{name}_labels"] = np.concatenate([l for _, l in clips]).astype(np.int8)
         arrays[f"{name}_lengths"] = np.array([len(m) for m, _ in clips], np.int64)
+    out.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(out, **arrays)
     return {name: len(arrays[f"{name}_lengths"]) for name in ("train", *held)}
 

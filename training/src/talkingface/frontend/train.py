@@ -74,16 +74,23 @@ def look_further(enc: ContentEncoder, cfg: ModelConfig) -> ContentEncoder:
     return out
 
 
-def load_speech(folder: Path) -> list[tuple[np.ndarray, np.ndarray]]:
+def load_speech(folder: Path, seen: set[str] | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
+    """A speech set's clips, (log-Mel, phone per Mel frame). With `seen`, a clip already read from another set (the
+    same index row: voice, text, seed, augmentation; sets built as variants of one draw share most clips) is left
+    out, and every row read is added to it."""
     rows = [json.loads(l) for l in (folder / "index.jsonl").read_text().splitlines()]
+    rows = [r for r in rows if "skipped" not in r]
+    if not rows:
+        raise SystemExit(f"no clips in {folder}: build it with python -m talkingface.frontend.speechset")
     out = []
     for r in rows:
-        if "skipped" in r:
-            continue
+        if seen is not None:
+            row = json.dumps(r, sort_keys=True)
+            if row in seen:
+                continue
+            seen.add(row)
         z = np.load(folder / f"{r['key']}.npz")
         out.append((z["mel"].astype(np.float32), z["labels"].astype(np.int64)))
-    if not out:
-        raise SystemExit(f"no clips in {folder}: build it with python -m talkingface.frontend.speechset")
     return out
 
 
@@ -122,7 +129,8 @@ def evaluate(enc: ContentEncoder, clips: list[tuple[np.ndarray, np.ndarray]], nu
 def read_speech(speech: list[Path], corpus: Path, no_corpus_train: bool, audio: AudioConfig) -> tuple[list, dict]:
     """-> training clips (the speech sets', and the corpus's train split unless no_corpus_train), and the corpus's
     {"val": clips, "test": clips}; each clip (log-Mel (K, n_mels), phone per Mel frame (K,))."""
-    clips = [c for folder in speech for c in load_speech(folder)]
+    seen: set[str] = set()  # a clip that several sets hold is read once
+    clips = [c for folder in speech for c in load_speech(folder, seen)]
     ds = open_dataset(corpus)
     prepared = lambda split: [(c.mel, c.phones) for c in (prepare(ds, k, audio) for k in ds.keys(split))]
     if not no_corpus_train:  # its festival and flite voices are few in the speech set; no val/test material
