@@ -13,7 +13,7 @@ import { FPS, SAMPLE_RATE, readWav16 } from './helpers/audio';
  */
 const SAMPLES = resolve(import.meta.dirname, '../../models/samples');
 const index = JSON.parse(readFileSync(resolve(SAMPLES, 'index.json'), 'utf8')) as {
-  clips: { name: string; audio: string; phones: [string, number, number][] }[];
+  clips: { name: string; audio: string; phones: [string, number, number][]; lip_gap_mm: number[] }[];
 };
 // The sample with the most bilabials.
 const clip = index.clips.map((c) => ({ c, n: c.phones.filter(([p]) => 'P B M'.split(' ').includes(p)).length }))
@@ -46,7 +46,9 @@ function offsetInLoop(take: number[], clipAudio: Float32Array): number {
 
 test('live from a microphone: the lips close on /p b m/ of an unseen voice', async ({ page }) => {
   test.setTimeout(120_000);
-  await page.goto('/dev/live.html?seconds=7&take=1');
+  // 14 s: about five passes of the clip, 15 /p b m/ and 120 other segments (7 s gave 58 others, and the false-alarm
+  // rate of four takes ran from 21% to 28%).
+  await page.goto('/dev/live.html?seconds=14&take=1');
   const handle = await page.waitForFunction(() => (globalThis as unknown as { liveResult?: unknown }).liveResult, null, { timeout: 90_000 });
   const r = (await handle.jsonValue()) as { error?: string; contourGaps: number[]; take: number[]; mmPerUnit: number };
   expect(r.error, r.error).toBeUndefined();
@@ -56,7 +58,8 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
   const loop = audio.length / sr;
   const gaps = r.contourGaps.map((g) => g * r.mmPerUnit);
   const takeSeconds = gaps.length / fps;
-  let hits = 0, trials = 0, falseHits = 0, others = 0;
+  const truth = clip.lip_gap_mm; // the corpus's own inner-lip gap for this clip, frame by frame from its start
+  let hits = 0, trials = 0, falseHits = 0, others = 0, truthFalse = 0;
   for (let k = -1; (k * loop) - off < takeSeconds; k++) {
     for (const [p, a, b] of clip.phones) {
       const [ta, tb] = [a + k * loop - off, b + k * loop - off];
@@ -65,13 +68,24 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
       for (let f = Math.ceil(ta * fps - 1e-6); f < Math.ceil(tb * fps - 1e-6); f++) frames.push(f);
       if (!frames.length) frames.push(Math.round(((ta + tb) / 2) * fps));
       const closed = Math.min(...frames.map((f) => gaps[f])) < 1.0;
-      if ('PBM'.includes(p) && p.length === 1) { trials++; hits += Number(closed); } else { others++; falseHits += Number(closed); }
+      if ('PBM'.includes(p) && p.length === 1) { trials++; hits += Number(closed); continue; }
+      others++;
+      falseHits += Number(closed);
+      // The truth on the same segment, on its own frame grid (the clip's frames from its start).
+      const own = [];
+      for (let f = Math.ceil(a * fps - 1e-6); f < Math.ceil(b * fps - 1e-6) && f < truth.length; f++) own.push(f);
+      if (!own.length) own.push(Math.min(truth.length - 1, Math.round(((a + b) / 2) * fps)));
+      truthFalse += Number(Math.min(...own.map((f) => truth[f])) < 1.0);
     }
   }
-  console.log(`${clip.name} through the fake microphone: /p b m/ closed ${hits}/${trials}, closed in other speech ${falseHits}/${others} (offset ${off.toFixed(3)} s)`);
-  expect(trials).toBeGreaterThanOrEqual(4);
-  // The shipped model closes 79% of the test split's /p b m/ (88% in its recorded speech; docs/results/default.md),
-  // the previous one none; issue 14's target of 95% is not reached yet. Held here: at least 70% through the browser.
-  expect(hits / trials, '/p b m/ segments with the lips closed').toBeGreaterThanOrEqual(0.7);
-  expect(falseHits / others, 'other speech segments with the lips closed').toBeLessThan(0.25);
+  console.log(`${clip.name} through the fake microphone: /p b m/ closed ${hits}/${trials}, closed in other speech ${falseHits}/${others}` +
+    ` (the truth ${truthFalse}/${others}; offset ${off.toFixed(3)} s)`);
+  expect(trials).toBeGreaterThanOrEqual(10);
+  // The shipped model closes 85% of the test split's /p b m/ (docs/results/default.md) and 86% in the browser
+  // (docs/results/peers.md); issue 14's target of 95% is not reached yet. Held here to the same: at least 85%.
+  expect(hits / trials, '/p b m/ segments with the lips closed').toBeGreaterThanOrEqual(0.85);
+  // Neighbours of /p b m/ share their closure, in the truth too (3 of this clip's 24 other segments). Offline, the
+  // same clip looped on the page's face closes 4 of 24 (17%, training's evaluation); through the microphone a take
+  // starts anywhere in a frame, and 7 s takes gave 21% to 28%. Held here: fewer than twice the truth's plus 10 points.
+  expect(falseHits / others, 'other speech segments with the lips closed').toBeLessThan(2 * truthFalse / others + 0.1);
 });
