@@ -74,3 +74,22 @@ def test_accuracy_by_kind_reads_the_confusion():
     assert r["consonant_frame_accuracy"] == 5 / 8
     assert r["vowel_frame_accuracy"] == 4 / 10
     assert r["lip_group_accuracy"] == (3 + 1 + 2 + 4 + 4) / 18
+
+
+def test_an_ensemble_averages_its_members_log_posteriors(trained_run, tmp_path):
+    import numpy as np
+    import torch
+    ck = trained_run / "final.pt"
+    ens, cfg = measure.load_encoder(f"{ck}+{ck}")
+    assert isinstance(ens, measure.Ensemble) and len(ens.members) == 2
+    enc, _ = measure.load_encoder(str(ck))
+    # the second member perturbed, so the mean is not either member's
+    with torch.no_grad():
+        for p in ens.members[1].parameters():
+            p.add_(0.01 * torch.randn_like(p))
+    mel = np.random.default_rng(2).standard_normal((90, 80)).astype(np.float32) + 4
+    with torch.no_grad():
+        lp = [m(torch.from_numpy(mel)[None])[0].log_softmax(-1) for m in ens.members]
+        torch.testing.assert_close(measure.heard(ens, mel), (lp[0] + lp[1]) / 2)
+        torch.testing.assert_close(lp[0], enc(torch.from_numpy(mel)[None])[0].log_softmax(-1))
+    assert cfg.content_classes == lp[0].shape[-1]

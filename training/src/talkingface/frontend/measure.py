@@ -10,7 +10,8 @@ a page could do, vocal-tract length normalisation without labels) or the one tha
 alignment (oracle: a bound, not a method; how far a better guess of the voice's tract length could go).
 
 Each FRONTEND is a front-end file (frontend.train's frontend.pt) or a face checkpoint, whose content encoder is read
-(models/checkpoint.pt: the shipped one). The numbers are those of `talkingface.train.evaluate`'s content encoder
+(models/checkpoint.pt: the shipped one); A+B+... is their ensemble, the mean of their log-posteriors (what a student
+distilled from them could hear at most, about). The numbers are those of `talkingface.train.evaluate`'s content encoder
 tables (docs/results/default.md) without training or running a face: a few seconds per split, so a new front-end
 can be compared with the shipped one on the held-out voices before a face is trained on it.
 """
@@ -33,8 +34,26 @@ from ..train.data import prepare
 from ..train.train import load_frontend
 
 
-def load_encoder(path: str) -> tuple[ContentEncoder, ModelConfig]:
-    """The content encoder of a front-end file or a face checkpoint, its Mel normalisation included."""
+class Ensemble(torch.nn.Module):
+    """Content encoders heard together: the mean of their log-posteriors, (1, K, n_mels) -> (1, Kc, D)."""
+
+    def __init__(self, encoders: list[ContentEncoder]):
+        super().__init__()
+        self.members = torch.nn.ModuleList(encoders)
+
+    def forward(self, mel: torch.Tensor) -> torch.Tensor:
+        return torch.stack([e(mel).log_softmax(-1) for e in self.members]).mean(0)
+
+
+def load_encoder(path: str) -> tuple[ContentEncoder | Ensemble, ModelConfig]:
+    """The content encoder of a front-end file or a face checkpoint, its Mel normalisation included; for "A+B+...",
+    their Ensemble (their content phones and strides must agree)."""
+    if "+" in path and not Path(path).exists():
+        members = [load_encoder(p) for p in path.split("+")]
+        cfgs = {(c.content_classes, c.content_stride) for _, c in members}
+        if len(cfgs) > 1:
+            raise ValueError(f"{path}: the front-ends hear different phone sets or strides ({sorted(cfgs)}), they cannot be averaged")
+        return Ensemble([e for e, _ in members]).eval(), members[0][1]
     ck = load_frontend(path)
     cfg = ModelConfig.from_dict(ck["model_config"])
     enc = ContentEncoder(cfg, AudioConfig().n_mels)
@@ -43,7 +62,7 @@ def load_encoder(path: str) -> tuple[ContentEncoder, ModelConfig]:
 
 
 @torch.no_grad()
-def heard(enc: ContentEncoder, mel: np.ndarray, warps: tuple[float, ...] = (1.0,)) -> torch.Tensor:
+def heard(enc: ContentEncoder | Ensemble, mel: np.ndarray, warps: tuple[float, ...] = (1.0,)) -> torch.Tensor:
     """(K, n_mels) log-Mel -> (Kc, D) logits; with several `warps`, the mean of the log-posteriors of the Mel axis
     warped by each (test-time averaging over vocal-tract lengths, as the training's frequency warp)."""
     if tuple(warps) == (1.0,):
@@ -100,7 +119,7 @@ def measure(enc: ContentEncoder, cfg: ModelConfig, clips, warps: tuple[float, ..
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m talkingface.frontend.measure", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("frontends", nargs="+", help="front-end files (frontend.pt) or face checkpoints")
+    ap.add_argument("frontends", nargs="+", help="front-end files (frontend.pt) or face checkpoints; A+B: their ensemble")
     ap.add_argument("--corpus", type=Path, required=True)
     ap.add_argument("--split", default="val,test", help="the corpus's splits to measure on, comma-separated (default: val,test)")
     ap.add_argument("--warps", default="1", help="Mel-axis warp factors whose log-posteriors are averaged, comma-separated "
