@@ -85,8 +85,8 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
   // (docs/results/peers.md); issue 14's target of 95% is not reached yet. Held here to the same: at least 85%.
   expect(hits / trials, '/p b m/ segments with the lips closed').toBeGreaterThanOrEqual(0.85);
   // Neighbours of /p b m/ share their closure, in the truth too (3 of this clip's 24 other segments). Offline
-  // (`python -m talkingface.train.looped`: the clip looped as here on the page's face), 17 to 25 of 96 (18% to 26%), by where in a frame
-  // the loop starts, which a take does not choose; 7 s takes gave 21% to 28%. Held here: fewer than twice the truth's
-  // rate plus 10 points.
+  // (`python -m talkingface.train.looped`: the clip looped as here, on the page's face), 17 to 25 of 96 (18% to
+  // 26%), by where in a frame the loop starts, which a take does not choose; 7 s takes gave 21% to 28%. Held here:
+  // fewer than twice the truth's rate plus 10 points.
   expect(falseHits / others, 'other speech segments with the lips closed').toBeLessThan(2 * truthFalse / others + 0.1);
 });
