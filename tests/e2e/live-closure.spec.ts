@@ -44,6 +44,13 @@ function offsetInLoop(take: number[], clipAudio: Float32Array): number {
   return fine;
 }
 
+/** Frames (at FPS, of `count`) whose time lies in [a, b) s, as training's articulation.segment_frames; the nearest if none. */
+function framesIn(a: number, b: number, count: number): number[] {
+  const out: number[] = [];
+  for (let f = Math.max(0, Math.ceil(a * FPS - 1e-6)); f < Math.min(count, Math.ceil(b * FPS - 1e-6)); f++) out.push(f);
+  return out.length ? out : [Math.min(count - 1, Math.max(0, Math.round(((a + b) / 2) * FPS)))];
+}
+
 test('live from a microphone: the lips close on /p b m/ of an unseen voice', async ({ page }) => {
   test.setTimeout(120_000);
   // 14 s: about five passes of the clip, 15 /p b m/ and 120 other segments (7 s gave 58 others, and the false-alarm
@@ -64,18 +71,12 @@ test('live from a microphone: the lips close on /p b m/ of an unseen voice', asy
     for (const [p, a, b] of clip.phones) {
       const [ta, tb] = [a + k * loop - off, b + k * loop - off];
       if (p === 'SIL' || ta < 0.5 || tb > takeSeconds - 0.2) continue; // skip the first half second (the stream warms up)
-      const frames = [];
-      for (let f = Math.ceil(ta * fps - 1e-6); f < Math.ceil(tb * fps - 1e-6); f++) frames.push(f);
-      if (!frames.length) frames.push(Math.round(((ta + tb) / 2) * fps));
-      const closed = Math.min(...frames.map((f) => gaps[f])) < 1.0;
+      const closed = Math.min(...framesIn(ta, tb, gaps.length).map((f) => gaps[f])) < 1.0;
       if ('PBM'.includes(p) && p.length === 1) { trials++; hits += Number(closed); continue; }
       others++;
       falseHits += Number(closed);
       // The truth on the same segment, on its own frame grid (the clip's frames from its start).
-      const own = [];
-      for (let f = Math.ceil(a * fps - 1e-6); f < Math.ceil(b * fps - 1e-6) && f < truth.length; f++) own.push(f);
-      if (!own.length) own.push(Math.min(truth.length - 1, Math.round(((a + b) / 2) * fps)));
-      truthFalse += Number(Math.min(...own.map((f) => truth[f])) < 1.0);
+      truthFalse += Number(Math.min(...framesIn(a, b, truth.length).map((f) => truth[f])) < 1.0);
     }
   }
   console.log(`${clip.name} through the fake microphone: /p b m/ closed ${hits}/${trials}, closed in other speech ${falseHits}/${others}` +
