@@ -25,7 +25,7 @@ export interface DecoderKernel {
   /** A copy of `values` where this kernel can read it. */
   place(values: Float32Array): Float32Array;
   placeInts(values: Int32Array): Int32Array;
-  /** Scratch for attention scores: `length` float64 (the SIMD kernel uses the space as float32, plus padding). */
+  /** Scratch for attention scores, `length` the longest key list: float64 each (the SIMD kernel's: 16 bytes each, four heads' float32 scores). */
   scratch(length: number): Float64Array;
   pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight;
   /** out[t, o] = b[o] + sum_i W[o, i] X[t, i] for t < rows (rows even for SIMD). */

@@ -38,6 +38,7 @@ interface SimdExports {
   matmul(wt: number, b: number, outs: number, cols: number, x: number, rows: number, out: number): void;
   layer_norm(x: number, rows: number, d: number, g: number, b: number, out: number, eps: number): void;
   attention(qkv: number, tokens: number, d: number, heads: number, keyStart: number, keyIndex: number, scores: number, out: number, scale: number): void;
+  attention_d32h4(qkv: number, tokens: number, keyStart: number, keyIndex: number, scores: number, out: number, scale: number): void;
   gelu(a: number, count: number, value: number, slope: number, range: number, steps: number): void;
   add(x: number, y: number, count: number): void;
 }
@@ -89,8 +90,9 @@ export class SimdKernel implements DecoderKernel {
     return a;
   }
 
+  /** `length` float64 for the TypeScript kernel's use; here 16 bytes per key (attention_d32h4: four heads' scores). */
   scratch(length: number): Float64Array {
-    return this.take(Float64Array, length);
+    return this.take(Float64Array, 2 * length + 2);
   }
 
   pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight {
@@ -125,6 +127,11 @@ export class SimdKernel implements DecoderKernel {
     scores: Float64Array, out: Float32Array): void {
     if ((d / heads) % 4) throw new Error('SimdKernel.attention: the head size must be a multiple of 4');
     this.mine(qkv, keyStart, keyIndex, scores, out);
+    if (d === 32 && heads === 4) {
+      // The model's shape: all four heads of a key at once (decoder.wat, attention_d32h4).
+      this.exports.attention_d32h4(qkv.byteOffset, tokens, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset, out.byteOffset, 1 / Math.sqrt(8));
+      return;
+    }
     this.exports.attention(qkv.byteOffset, tokens, d, heads, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset,
       out.byteOffset, 1 / Math.sqrt(d / heads));
   }
