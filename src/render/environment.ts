@@ -43,16 +43,24 @@ const LOBES: Lobe[] = [
   { dir: [0, 1, 0], k: sharpness(0.5), rgb: [1.8, 1.75, 1.7] }, // ceiling panel
 ];
 
+/** LOBES flat, seven numbers a lobe: k dir (3), k, rgb (3); studioRadiance reads them for every sample of the prefilter. */
+const LOBE_TERMS = Float64Array.from(LOBES.flatMap((l) => [l.k * l.dir[0], l.k * l.dir[1], l.k * l.dir[2], l.k, ...l.rgb]));
+
 /** The studio's radiance (linear RGB) in the world direction d (unit length), written to out. */
-export function studioRadiance(dx: number, dy: number, dz: number, out: Float32Array | number[], at = 0): void {
+export function studioRadiance(dx: number, dy: number, dz: number, out: Float32Array | Float64Array | number[], at = 0): void {
   // The room: the floor darker and warmer, the ceiling a light grey.
   const up = 0.5 + 0.5 * dy;
   let r = 0.1 + 0.32 * up, g = 0.09 + 0.31 * up, b = 0.08 + 0.3 * up;
-  for (const l of LOBES) {
-    const w = Math.exp(l.k * (dx * l.dir[0] + dy * l.dir[1] + dz * l.dir[2] - 1));
-    r += w * l.rgb[0];
-    g += w * l.rgb[1];
-    b += w * l.rgb[2];
+  const L = LOBE_TERMS;
+  for (let i = 0; i < L.length; i += 7) {
+    const e = dx * L[i] + dy * L[i + 1] + dz * L[i + 2] - L[i + 3]; // k (d.dir - 1)
+    // Far from a lobe it adds less than e^-20 x 14 (3e-8) to a radiance of 0.08 or more, below what the texture's
+    // half floats hold (1 part in 2048); the exponential is most of the prefilter's time.
+    if (e < -20) continue;
+    const w = Math.exp(e);
+    r += w * L[i + 4];
+    g += w * L[i + 5];
+    b += w * L[i + 6];
   }
   out[at] = r;
   out[at + 1] = g;
@@ -86,39 +94,69 @@ function hammersley(i: number, n: number): [number, number] {
 }
 
 /**
- * The studio's radiance prefiltered for roughness `roughness` in direction n: the n.l-weighted mean of GGX
- * importance samples (alpha = roughness^2) around n, with v = n.
+ * GGX importance samples of the half vector h for one roughness (alpha = roughness^2), in a tangent frame whose z is
+ * n, and each one's weight n.l = 2 (n.h)^2 - 1 (l = 2 (n.h) h - n, v = n). Only those with n.l > 0, which are the
+ * same for every direction n: computed once per roughness, not once per texel.
  */
-export function prefiltered(n: [number, number, number], roughness: number, out: Float32Array, at: number): void {
-  if (roughness <= 0) return studioRadiance(n[0], n[1], n[2], out, at);
+interface GgxSamples {
+  /** h per sample: x, y, z (z = n.h) in the tangent frame. */
+  h: Float64Array;
+  /** n.l per sample, and their sum. */
+  weight: Float64Array;
+  total: number;
+}
+
+const ggxSets = new Map<number, GgxSamples>();
+
+function ggxSamples(roughness: number): GgxSamples {
+  let set = ggxSets.get(roughness);
+  if (set) return set;
   const a = roughness * roughness;
-  // A tangent frame around n.
-  const [nx, ny, nz] = n;
-  const [tx, ty, tz] = Math.abs(nz) < 0.999 ? normalize(-ny, nx, 0) : normalize(0, -nz, ny);
-  const bx = ny * tz - nz * ty, by = nz * tx - nx * tz, bz = nx * ty - ny * tx;
-  const c = [0, 0, 0];
-  let r = 0, g = 0, b = 0, total = 0;
+  const h: number[] = [], weight: number[] = [];
   for (let i = 0; i < SAMPLES; i++) {
     const [xi1, xi2] = hammersley(i, SAMPLES);
     const phi = 2 * Math.PI * xi1;
     const cosT = Math.sqrt((1 - xi2) / (1 + (a * a - 1) * xi2));
     const sinT = Math.sqrt(1 - cosT * cosT);
-    const hx = sinT * Math.cos(phi), hy = sinT * Math.sin(phi), hz = cosT;
+    const nl = 2 * cosT * cosT - 1;
+    if (nl <= 0) continue;
+    h.push(sinT * Math.cos(phi), sinT * Math.sin(phi), cosT);
+    weight.push(nl);
+  }
+  set = { h: Float64Array.from(h), weight: Float64Array.from(weight), total: weight.reduce((sum, w) => sum + w, 0) };
+  ggxSets.set(roughness, set);
+  return set;
+}
+
+/**
+ * The studio's radiance prefiltered for roughness `roughness` in direction n: the n.l-weighted mean of GGX
+ * importance samples (alpha = roughness^2) around n, with v = n.
+ */
+export function prefiltered(n: [number, number, number], roughness: number, out: Float32Array, at: number): void {
+  if (roughness <= 0) return studioRadiance(n[0], n[1], n[2], out, at);
+  const { h, weight, total } = ggxSamples(roughness);
+  // A tangent frame around n.
+  const [nx, ny, nz] = n;
+  const [tx, ty, tz] = Math.abs(nz) < 0.999 ? normalize(-ny, nx, 0) : normalize(0, -nz, ny);
+  const bx = ny * tz - nz * ty, by = nz * tx - nx * tz, bz = nx * ty - ny * tx;
+  const c = radiance;
+  let r = 0, g = 0, b = 0;
+  for (let i = 0; i < weight.length; i++) {
+    const hx = h[3 * i], hy = h[3 * i + 1], hz = h[3 * i + 2];
     // h in the world, then l = 2 (n.h) h - n.
     const wx = hx * tx + hy * bx + hz * nx, wy = hx * ty + hy * by + hz * ny, wz = hx * tz + hy * bz + hz * nz;
-    const lx = 2 * cosT * wx - nx, ly = 2 * cosT * wy - ny, lz = 2 * cosT * wz - nz;
-    const nl = lx * nx + ly * ny + lz * nz;
-    if (nl <= 0) continue;
-    studioRadiance(lx, ly, lz, c);
-    r += nl * c[0];
-    g += nl * c[1];
-    b += nl * c[2];
-    total += nl;
+    studioRadiance(2 * hz * wx - nx, 2 * hz * wy - ny, 2 * hz * wz - nz, c);
+    r += weight[i] * c[0];
+    g += weight[i] * c[1];
+    b += weight[i] * c[2];
   }
   out[at] = r / total;
   out[at + 1] = g / total;
   out[at + 2] = b / total;
 }
+
+/** prefiltered's scratch: one sample's radiance. */
+const radiance = new Float64Array(3);
 
 /**
  * The prefiltered studio as linear RGBA floats: levels[lod][face] holds size >> lod squared texels, rows top to
