@@ -147,7 +147,7 @@ function print(r: Record<string, unknown>): void {
   }
   console.log(`\nmodel load ${f(r.model_load_ms as number, 0)} ms (${f((r.model_load_transfer_bytes as number) / 2 ** 20, 2)} MiB transferred, onnxruntime ${r.ort_build} build), ` +
     `model files ${f((r.model_bytes as number) / 1e6, 2)} MB, first frame ${f(r.first_frame_ms as number, 0)} ms; ` +
-    `CPU decoder: ${r.cpu_decoder_kernel} on ${r.cpu_decoder_threads} thread(s)`);
+    `CPU decoder: ${r.cpu_decoder_kernel}${r.cpu_decoder_fma ? ' (fused multiply-add)' : ''} on ${r.cpu_decoder_threads} thread(s)`);
   console.log(`streaming latency (sample in -> frame out) p50 ${f(r.stream_latency_ms as number, 0)} ms, p95 ${f(r.stream_latency_p95_ms as number, 0)} ms; ` +
     `of which look-ahead ${f(r.stream_look_ahead_ms as number, 0)} ms, pieces of ${f(r.stream_piece_ms as number, 0)} ms`);
   console.log('decoder time per frame by vertex count:', JSON.stringify(r.attention_by_vertices));

@@ -8,10 +8,11 @@ import { SimdKernel } from '../../../src/attention/simd-kernel';
 import { assemble, generatedSource, KERNELS } from '../../../scripts/build-wasm';
 import { ROOT, maxAbsDiff } from '../helpers/exported';
 
+const wave = (n: number, f: number, a = 1) => Float32Array.from({ length: n }, (_, i) => a * Math.sin(i * f + 0.3));
+
 describe('the SIMD kernel', () => {
   it('the SIMD kernel\'s operations equal the TypeScript kernel\'s, for every remainder', () => {
     const simd = new SimdKernel(1 << 20);
-    const wave = (n: number, f: number, a = 1) => Float32Array.from({ length: n }, (_, i) => a * Math.sin(i * f + 0.3));
     // Matrix products: outputs in 16s and 4s (and not a multiple of 4: the TypeScript product), odd column counts.
     for (const [rows, outs, cols] of [[2, 4, 1], [2, 16, 5], [4, 20, 7], [6, 36, 32], [2, 6, 8], [470, 96, 32]]) {
       const W = wave(outs * cols, 1.3), b = wave(outs, 0.9);
@@ -69,10 +70,25 @@ describe('the SIMD kernel', () => {
     }
   });
 
+  it('fuses its matrix products where relaxed SIMD is there (vitest runs Node with it), and they equal the plain ones', () => {
+    const fused = new SimdKernel(1 << 20);
+    const plain = new SimdKernel(1 << 20, false);
+    expect([fused.fusedMultiplyAdd, plain.fusedMultiplyAdd]).toEqual([true, false]);
+    for (const [rows, outs, cols] of [[2, 4, 3], [4, 20, 7], [470, 96, 32], [470, 32, 64]]) {
+      const W = wave(outs * cols, 1.3), b = wave(outs, 0.9), X = wave(rows * cols, 0.7);
+      const [a, c] = [fused, plain].map((k) => {
+        const out = k.alloc(rows * outs);
+        k.matmul(k.pack(W, b, outs, cols), k.place(X), rows, out);
+        return out;
+      });
+      expect(maxAbsDiff(a, c)).toBeLessThan(1e-6 * cols);
+    }
+  });
+
   it('the embedded WebAssembly is what the committed .wat assembles to (npm run build:wasm)', async () => {
     for (const k of KERNELS) {
-      const bytes = await assemble(k.wat);
-      expect(readFileSync(resolve(ROOT, k.out), 'utf8')).toBe(generatedSource(k.wat, bytes));
+      const bytes = await assemble(k);
+      expect(readFileSync(resolve(ROOT, k.out), 'utf8')).toBe(generatedSource(k, bytes));
     }
   });
 });
