@@ -52,7 +52,7 @@ type Sexp = string | Sexp[];
 /**
  * A module of the .wat's `matmul` alone, on the memory it imports (kernel.memory: the decoder kernel's), with every
  * (f32x4.add acc (f32x4.mul w x)) made (f32x4.relaxed_madd w x acc): one instruction where the CPU has fused
- * multiply-add, and a rounding fewer. Relaxed SIMD is newer than SIMD (Safari lacks it, Node 20 has it behind
+ * multiply-add, and a rounding fewer. Relaxed SIMD is newer than SIMD (not every browser has it, Node 20 has it behind
  * --experimental-wasm-relaxed-simd), so it is a module apart, used where it validates (simd-kernel.ts).
  */
 export function fmaMatmul(wat: string): string {
