@@ -36,9 +36,10 @@ let fmaModule: WebAssembly.Module | null | undefined;
 
 /**
  * The matrix product with fused multiply-adds (relaxed SIMD's f32x4.relaxed_madd; simd/matmul-fma-wasm.ts, made by
- * `npm run build:wasm` from decoder.wat's matmul), or null where this runtime lacks relaxed SIMD (not every browser has it; Node
- * without --experimental-wasm-relaxed-simd), where the plain product runs. A quarter faster than it in Chromium on this
- * machine (an x86 CPU with FMA), and one rounding fewer per multiply-add; on a CPU without FMA the same numbers as it.
+ * `npm run build:wasm` from decoder.wat's matmul), or null where this runtime lacks relaxed SIMD (not every browser
+ * has it; Node without --experimental-wasm-relaxed-simd), where the plain product runs. One rounding fewer per
+ * multiply-add where the CPU has FMA, and faster (the SIMD decoder 5% to 24% in Chromium on this machine:
+ * docs/results/README.md, Speed); on a CPU without FMA the same numbers as the plain product.
  */
 export function fmaMatmulModule(): WebAssembly.Module | null {
   if (fmaModule !== undefined) return fmaModule;
