@@ -6,7 +6,7 @@ import { TalkingFaceEngine, type Backend } from '../src/engine/engine';
 import { decodeAudio } from '../src/audio/decode';
 import { ReferenceDecoder } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
-import { fmaMatmulModule } from '../src/attention/simd-kernel';
+import { fmaModule } from '../src/attention/simd-kernel';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
 import { requestSharedDevice, detectWebGPU } from '../src/gpu/capabilities';
 import { buildAdjacency } from '../src/template/mesh-topology';
@@ -54,7 +54,7 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   if (renderOnly) return result;
   result.cpu_decoder_threads = engine.cpuThreads;
   result.cpu_decoder_kernel = engine.cpuKernel;
-  result.cpu_decoder_fma = fmaMatmulModule() !== null; // its matrix products fused (relaxed SIMD)
+  result.cpu_decoder_fma = fmaModule() !== null; // its matrix products and GELU fused (relaxed SIMD)
   const bytes = await Promise.all(engine.manifest.runtime_files.map(async (k) => (await fetch(`/models/${engine.manifest.files[k]}`)).arrayBuffer()));
   result.model_bytes = bytes.reduce((s, b) => s + b.byteLength, 0);
 

@@ -8,7 +8,7 @@ import { parseSafetensors, f32 } from '../src/model/safetensors';
 import { MM_PER_UNIT, loadTemplate } from '../src/template/face-template';
 import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
-import { fmaMatmulModule } from '../src/attention/simd-kernel';
+import { fmaModule } from '../src/attention/simd-kernel';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
 import { detectWebGPU, requestSharedDevice } from '../src/gpu/capabilities';
 import { TalkingFaceEngine } from '../src/engine/engine';
@@ -46,7 +46,7 @@ async function main() {
     result.gpuRepeatable = maxAbsDiff(again.offsets, g.offsets) === 0;
     dec.destroy();
   }
-  result.simdFusedMultiplyAdd = fmaMatmulModule() !== null; // the SIMD decoder's matrix products fused (relaxed SIMD)
+  result.simdFusedMultiplyAdd = fmaModule() !== null; // the SIMD decoder's matrix products and GELU fused (relaxed SIMD)
   for (const kernel of ['wasm-simd', 'js'] as const) {
     const fast = new FastDecoder(weights, template.adjacency, m, kernel).decode(tokens, poseTok, frames);
     result[`fast_${kernel}_VsCpuOffsets`] = maxAbsDiff(fast.offsets, cpu.offsets);

@@ -6,7 +6,7 @@ import type { FaceTemplate } from '../template/face-template';
 import type { WebGPUSupport } from '../gpu/capabilities';
 import type { Backend, TalkingFaceEngine } from '../engine/engine';
 import { tell, ui } from './controls';
-import { fmaMatmulModule, simdUnavailable } from '../attention/simd-kernel';
+import { fmaModule, simdUnavailable } from '../attention/simd-kernel';
 import { SHORT_CLIP_SECONDS } from '../player/player';
 import type { Take } from './take-view';
 
@@ -17,7 +17,7 @@ export function setupDetails(face: FaceTemplate, gpu: WebGPUSupport): string {
 
 /** The decoder's line: which one, why, and the CPU decoder's arithmetic and threads. */
 export function decoderDetails(e: TalkingFaceEngine): string {
-  const simd = `WebAssembly SIMD${fmaMatmulModule() ? ', fused multiply-add' : ''}`;
+  const simd = `WebAssembly SIMD${fmaModule() ? ', fused multiply-add' : ''}`;
   const kernel = e.cpuKernel === 'wasm-simd' ? simd : `JavaScript (no SIMD: ${simdUnavailable || 'unavailable'})`;
   return `Decoder: ${e.backend} (${e.backendReason}; CPU decoder: ${kernel} on ${e.cpuThreads} thread${e.cpuThreads > 1 ? 's' : ''}).`;
 }

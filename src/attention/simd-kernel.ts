@@ -4,7 +4,7 @@
  * TypeScript kernel (decoder-kernels.ts) runs instead, and simdUnavailable says why.
  */
 import { WASM_BASE64 } from './simd/decoder-wasm';
-import { WASM_BASE64 as FMA_MATMUL_BASE64 } from './simd/matmul-fma-wasm';
+import { WASM_BASE64 as FMA_BASE64 } from './simd/decoder-fma-wasm';
 import { GELU_RANGE, GELU_STEPS, geluTableData, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
 
 let module: WebAssembly.Module | null | undefined;
@@ -32,22 +32,22 @@ export function simdModule(): WebAssembly.Module | null {
   return module;
 }
 
-let fmaModule: WebAssembly.Module | null | undefined;
+let fused: WebAssembly.Module | null | undefined;
 
 /**
- * The matrix product with fused multiply-adds (relaxed SIMD's f32x4.relaxed_madd; simd/matmul-fma-wasm.ts, made by
- * `npm run build:wasm` from decoder.wat's matmul), or null where this runtime lacks relaxed SIMD (not every browser
- * has it; Node without --experimental-wasm-relaxed-simd), where the plain product runs. One rounding fewer per
- * multiply-add where the CPU has FMA, and faster (the SIMD decoder 5% to 24% in Chromium on this machine:
- * docs/results/README.md, Speed); on a CPU without FMA the same numbers as the plain product.
+ * The matrix product and GELU with fused multiply-adds (relaxed SIMD's f32x4.relaxed_madd; simd/decoder-fma-wasm.ts,
+ * made by `npm run build:wasm` from decoder.wat's matmul and gelu), or null where this runtime lacks relaxed SIMD (not
+ * every browser has it; Node without --experimental-wasm-relaxed-simd), where the plain ones run. One rounding fewer
+ * per multiply-add where the CPU has FMA, and faster (docs/results/README.md, Speed); on a CPU without FMA the same
+ * numbers as the plain ones.
  */
-export function fmaMatmulModule(): WebAssembly.Module | null {
-  if (fmaModule !== undefined) return fmaModule;
-  fmaModule = null;
-  if (simdModule() === null) return fmaModule;
-  const bytes = fromBase64(FMA_MATMUL_BASE64);
-  if (WebAssembly.validate(bytes)) fmaModule = new WebAssembly.Module(bytes);
-  return fmaModule;
+export function fmaModule(): WebAssembly.Module | null {
+  if (fused !== undefined) return fused;
+  fused = null;
+  if (simdModule() === null) return fused;
+  const bytes = fromBase64(FMA_BASE64);
+  if (WebAssembly.validate(bytes)) fused = new WebAssembly.Module(bytes);
+  return fused;
 }
 
 function fromBase64(b64: string): Uint8Array<ArrayBuffer> {
@@ -69,14 +69,15 @@ interface SimdExports {
 
 /**
  * The SIMD kernel over one memory of `bytes` bytes (everything alloc'd, placed and packed, plus alignment); its matrix
- * products with fused multiply-adds where the runtime has relaxed SIMD, unless `fma` is false.
+ * products and GELU with fused multiply-adds where the runtime has relaxed SIMD, unless `fma` is false.
  */
 export class SimdKernel implements DecoderKernel {
   readonly name = 'wasm-simd';
-  /** Whether the matrix products fuse their multiply-adds (fmaMatmulModule). */
+  /** Whether the matrix products and GELU fuse their multiply-adds (fmaModule). */
   readonly fusedMultiplyAdd: boolean;
   private readonly exports: SimdExports;
-  private readonly matmulOf: SimdExports['matmul'];
+  /** matmul and gelu: the fused module's where there is one, else the plain module's. */
+  private readonly fusable: Pick<SimdExports, 'matmul' | 'gelu'>;
   private used = 0;
   private readonly capacity: number;
   private readonly geluValue: Float64Array;
@@ -86,10 +87,12 @@ export class SimdKernel implements DecoderKernel {
     const mod = simdModule();
     if (!mod) throw new Error('WebAssembly SIMD is not available in this runtime');
     this.exports = new WebAssembly.Instance(mod).exports as unknown as SimdExports;
-    const fused = fma ? fmaMatmulModule() : null;
-    this.fusedMultiplyAdd = fused !== null;
-    // The fused product works on this kernel's memory (it imports it), so it takes the same byte addresses.
-    this.matmulOf = fused ? (new WebAssembly.Instance(fused, { kernel: { memory: this.exports.memory } }).exports as unknown as SimdExports).matmul : this.exports.matmul;
+    const fusedModule = fma ? fmaModule() : null;
+    this.fusedMultiplyAdd = fusedModule !== null;
+    // The fused module works on this kernel's memory (it imports it), so it takes the same byte addresses.
+    this.fusable = fusedModule
+      ? new WebAssembly.Instance(fusedModule, { kernel: { memory: this.exports.memory } }).exports as unknown as SimdExports
+      : this.exports;
     const table = geluTableData();
     const need = bytes + 16 * table.value.length + 4096;
     const have = this.exports.memory.buffer.byteLength;
@@ -149,7 +152,7 @@ export class SimdKernel implements DecoderKernel {
     }
     if (rows % 2) throw new Error('SimdKernel.matmul: rows must be even');
     this.mine(X, out);
-    this.matmulOf(p.w.byteOffset, p.b.byteOffset, p.outs, p.cols, X.byteOffset, rows, out.byteOffset);
+    this.fusable.matmul(p.w.byteOffset, p.b.byteOffset, p.outs, p.cols, X.byteOffset, rows, out.byteOffset);
   }
 
   layerNorm(X: Float32Array, rows: number, d: number, g: Float32Array, b: Float32Array, out: Float32Array, eps: number): void {
@@ -172,7 +175,7 @@ export class SimdKernel implements DecoderKernel {
 
   gelu(a: Float32Array, count: number): void {
     this.mine(a);
-    this.exports.gelu(a.byteOffset, count, this.geluValue.byteOffset, this.geluSlope.byteOffset, GELU_RANGE, GELU_STEPS);
+    this.fusable.gelu(a.byteOffset, count, this.geluValue.byteOffset, this.geluSlope.byteOffset, GELU_RANGE, GELU_STEPS);
   }
 
   add(x: Float32Array, y: Float32Array, count: number): void {

@@ -70,7 +70,7 @@ describe('the SIMD kernel', () => {
     }
   });
 
-  it('fuses its matrix products where relaxed SIMD is there (vitest runs Node with it), and they equal the plain ones', () => {
+  it('fuses its matrix products and GELU where relaxed SIMD is there (vitest runs Node with it), and they equal the plain ones', () => {
     const fused = new SimdKernel(1 << 20);
     const plain = new SimdKernel(1 << 20, false);
     expect([fused.fusedMultiplyAdd, plain.fusedMultiplyAdd]).toEqual([true, false]);
@@ -83,6 +83,14 @@ describe('the SIMD kernel', () => {
       });
       expect(maxAbsDiff(a, c)).toBeLessThan(1e-6 * cols);
     }
+    const xs = Float32Array.from({ length: 4003 }, (_, i) => -10 + i / 200);
+    const [a, c] = [fused, plain].map((k) => {
+      const out = k.place(xs);
+      k.gelu(out, out.length);
+      return out;
+    });
+    expect(maxAbsDiff(a, c)).toBeLessThan(1e-6);
+    expect(maxAbsDiff(a, c)).toBeGreaterThan(0); // the fused GELU is not the plain one
   });
 
   it('the embedded WebAssembly is what the committed .wat assembles to (npm run build:wasm)', async () => {
