@@ -69,7 +69,7 @@ export class FastDecoder {
     if (simd) {
       const L = weights.layers.length;
       const floats = rows * (6 * d + m.ffn) + L * (4 * d * d + 2 * d * m.ffn + 8 * d + m.ffn) + 2 * d
-        + lists.keyStart.length + lists.keys.length + 4 * (n + 1) + 4; // the scores: SimdKernel.scratch
+        + lists.keyStart.length + lists.keys.length + SimdKernel.scratchFloats(n + 1);
       const allocations = 8 + 14 * L;
       this.kernel = new SimdKernel(4 * floats + 16 * allocations);
     } else {

@@ -129,7 +129,12 @@ export class SimdKernel implements DecoderKernel {
 
   /** `length` float64 for the TypeScript kernel's use; here 16 bytes per key (attention_d32h4: four heads' scores). */
   scratch(length: number): Float64Array {
-    return this.take(Float64Array, 2 * length + 2);
+    return this.take(Float64Array, SimdKernel.scratchFloats(length) / 2);
+  }
+
+  /** The float32s scratch(length) takes of the kernel's memory (for sizing it). */
+  static scratchFloats(length: number): number {
+    return 4 * length + 4;
   }
 
   pack(W: Float32Array, b: Float32Array, outs: number, cols: number): PackedWeight {

@@ -65,12 +65,13 @@ def main(argv=None) -> int:
     gap, gain = lc.calibration(ck)
     truth = art.segment_counts(np.asarray(clip["lip_gap_mm"], np.float64), clip["phones"], clip["fps"])
     print(f"{args.clip}, looped {args.loops} times on the template's face ({args.checkpoint}); passes 2-{args.loops} counted")
+    def closed(c: dict) -> str:
+        return (f"/p b m/ closed {c['bilabial_closed']}/{c['bilabial']}, "
+                f"other speech closed {c['other_closed']}/{c['other']} ({c['other_closed'] / max(c['other'], 1):.0%})")
     for ms in (float(m) for m in args.phases_ms.split(",") if m):
         c = looped_counts(model, template, gap, gain, audio, sr, clip["phones"], args.loops, ms / 1000)
-        print(f"  loop starts {ms:4.0f} ms into a frame: /p b m/ closed {c['bilabial_closed']}/{c['bilabial']}, "
-              f"other speech closed {c['other_closed']}/{c['other']} ({c['other_closed'] / max(c['other'], 1):.0%})")
-    print(f"  the truth, one pass: /p b m/ closed {truth['bilabial_closed']}/{truth['bilabial']}, other speech closed "
-          f"{truth['other_closed']}/{truth['other']} ({truth['other_closed'] / max(truth['other'], 1):.0%})")
+        print(f"  loop starts {ms:4.0f} ms into a frame: {closed(c)}")
+    print(f"  the truth, one pass: {closed(truth)}")
     return 0
 
 
