@@ -10,7 +10,8 @@
 # of 256 crops, with its front-end kept about five times on the way (--snapshots, to be chosen on val afterwards),
 # and is packed into OUT/<recipe>.tar with its log (the optimiser's checkpoint stays behind). A recipe still running
 # two minutes past its budget is stopped, its snapshots so far kept. Runs on the CPU too (slowly): DEVICE=cpu
-# (PYTHON names the interpreter: scripts/py's venv here, the machine's python3 by default).
+# (PYTHON names the interpreter: scripts/py's venv here, the machine's python3 by default). EVERY=N keeps a snapshot
+# every N steps instead, without the short run (where the time on the machine is short and the setup was tried here).
 # RECIPES, where given, is a file of recipes, one a line: a name, then frontend.train's options (# starts a comment);
 # scripts/frontend-gpu-timbre.txt is the second run's. Without it, the first run's six below.
 set -euo pipefail
@@ -33,11 +34,16 @@ train() {  # name, then frontend.train's options
   tar -C "$work" -cf "$out/$name.tar" --exclude checkpoint.pt "$name" "$name.log"
 }
 
-"$python" -m talkingface.frontend.train --packed "$bank" --out "$work/smoke" --device "$device" --threads 2 \
-  --batch 256 --steps 200 --eval-every 100 --consistency 1 2>&1 | tee "$work/smoke.log"
-rate=$(grep -o '[0-9.]* steps/s' "$work/smoke.log" | tail -n 1 | cut -d' ' -f1)
-every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 5 / 100) * 100; print (e < 100 ? 100 : e) }")
-echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
+if [[ -n ${EVERY:-} ]]; then
+  every=$EVERY
+  echo "a snapshot every $every steps (EVERY; no smoke run)"
+else
+  "$python" -m talkingface.frontend.train --packed "$bank" --out "$work/smoke" --device "$device" --threads 2 \
+    --batch 256 --steps 200 --eval-every 100 --consistency 1 2>&1 | tee "$work/smoke.log"
+  rate=$(grep -o '[0-9.]* steps/s' "$work/smoke.log" | tail -n 1 | cut -d' ' -f1)
+  every=$(awk "BEGIN { e = int($rate * $minutes * 60 / 5 / 100) * 100; print (e < 100 ? 100 : e) }")
+  echo "smoke run: $rate steps/s (two views); a snapshot every $every steps"
+fi
 
 if [[ -n $recipes ]]; then
   set -f # the options are words, never file patterns

@@ -97,6 +97,18 @@ def test_train_a_little_then_use_it_frozen(corpus, tmp_path):
     assert json.loads((one_view / "frontend_eval.json").read_text())["step"] == 2
     with pytest.raises(SystemExit):
         fe_train.main(["--packed", str(packed), "--out", str(tmp_path / "x"), "--timbre", "1.5"])
+    # --teacher distils from an ensemble of front-ends (here two) while it learns the labels
+    student = tmp_path / "fe-student"
+    fe_train.main(["--packed", str(packed), "--out", str(student), "--steps", "2", "--eval-every", "1000", "--threads", "1",
+                   "--init", str(out / "frontend.pt"), "--teacher", f"{out / 'frontend.pt'}+{again / 'frontend.pt'}",
+                   "--distill", "2"])
+    fe5 = torch.load(student / "frontend.pt", weights_only=False)
+    assert fe5["args"]["distill"] == 2 and fe5["step"] == 2
+    odd = dict(fe, model_config=fe["model_config"] | {"content_stride": 2 * fe["model_config"]["content_stride"]})
+    torch.save(odd, tmp_path / "odd.pt")
+    with pytest.raises(SystemExit, match="another phone set or stride"):
+        fe_train.main(["--packed", str(packed), "--out", str(tmp_path / "x"), "--steps", "1", "--threads", "1",
+                       "--teacher", str(tmp_path / "odd.pt")])
 
 
 def test_widening_keeps_the_function_and_the_new_channels_learn():
@@ -145,6 +157,20 @@ def test_view_disagreement_is_zero_for_the_same_posteriors_only():
     b = a.clone()
     b[:, 5:] = torch.randn(3, 5, 40)
     assert fe_train.view_disagreement(torch.cat([a, b]), real).abs() < 1e-6
+
+
+def test_distillation_is_zero_where_the_student_hears_as_the_teacher_does():
+    logits = torch.randn(2, 10, 40)
+    real = torch.ones(2, 10, dtype=torch.bool)
+    assert fe_train.distillation(logits, logits.log_softmax(-1), real).abs() < 1e-6
+    assert fe_train.distillation(logits, torch.randn(2, 10, 40).log_softmax(-1), real) > 0.1
+    teacher = logits.log_softmax(-1).clone()
+    teacher[:, 5:] = torch.randn(2, 5, 40).log_softmax(-1)
+    real[:, 5:] = False  # padded frames do not count
+    assert fe_train.distillation(logits, teacher, real).abs() < 1e-6
+    loss = fe_train.distillation(logits.requires_grad_(), torch.randn(2, 10, 40).log_softmax(-1), real)
+    loss.backward()  # the student learns, towards the teacher, on the frames that count
+    assert logits.grad[:, :5].abs().sum() > 0 and logits.grad[:, 5:].abs().sum() == 0
 
 
 def test_a_clip_several_speech_sets_hold_is_read_once(tmp_path):

@@ -34,6 +34,7 @@ from ..train import articulation as art
 from ..train.data import prepare
 from ..train.train import load_frontend
 from .bank import Bank, PAD_LABEL, spec_augment, timbre, unpack, warp, warp_factors
+from .measure import load_encoder
 
 
 def widen(enc: ContentEncoder, cfg: ModelConfig, seed: int = 0) -> ContentEncoder:
@@ -114,6 +115,16 @@ def view_disagreement(logits: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
     return (kl * m).sum() / m.sum().clamp(min=1)
 
 
+def distillation(logits: torch.Tensor, teacher: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
+    """KL divergence from a teacher's log-posteriors to the student's, over the frames that are not padding.
+    logits (B, K, D) the student's, teacher (B, K', D) log-posteriors, real (B, K) -> a scalar."""
+    k = min(logits.shape[1], teacher.shape[1], real.shape[1])
+    s, t = logits[:, :k].log_softmax(-1), teacher[:, :k]
+    kl = (t.exp() * (t - s)).sum(-1)
+    m = real[:, :k].float()
+    return (kl * m).sum() / m.sum().clamp(min=1)
+
+
 @torch.no_grad()
 def evaluate(enc: ContentEncoder, clips: list[tuple[np.ndarray, np.ndarray]], num_classes: int, stride: int) -> dict:
     """Frame accuracy, per-phone recall and /p b m/ heard over (mel, phones) clips."""
@@ -189,6 +200,12 @@ def main(argv=None) -> int:
     ap.add_argument("--timbre", type=float, default=0.0, metavar="FRACTION",
                     help="give this fraction of the crops another timbre (bank.timbre: a smooth random gain along the Mel "
                          "axis, the fine structure across bands partly smoothed); with --consistency each view its own")
+    ap.add_argument("--teacher", metavar="FRONTEND",
+                    help="distil from this front-end (a frontend.pt or a face checkpoint; A+B+...: their ensemble, the mean "
+                         "of their log-posteriors, as frontend.measure hears it), heard on each crop before its masks")
+    ap.add_argument("--distill", type=float, default=1.0, metavar="WEIGHT",
+                    help="with --teacher: WEIGHT x the KL divergence from the teacher's posteriors to the student's, added "
+                         "to the cross-entropy against the labels (which keeps its --bilabial-weight)")
     ap.add_argument("--bilabial-weight", type=float, default=2.0,
                     help="cross-entropy weight of P, B and M frames: a missed bilabial costs a closed mouth")
     args = ap.parse_args(argv)
@@ -232,6 +249,13 @@ def main(argv=None) -> int:
             (f", widened from {init_cfg.content_channels} to {args.channels} channels" if init_cfg.content_channels < args.channels else "") +
             (f", with a last block reading {args.ahead} content frames ahead" if init_cfg.content_ahead != args.ahead else "") + ")")
     enc.to(args.device)
+    teacher = None
+    if args.teacher:
+        teacher, teacher_cfg = load_encoder(args.teacher)
+        if (teacher_cfg.content_classes, teacher_cfg.content_stride) != (cfg.content_classes, cfg.content_stride):
+            raise SystemExit(f"--teacher: {args.teacher} hears another phone set or stride than the student")
+        teacher.to(args.device).eval().requires_grad_(False)
+        log(f"distilling from {args.teacher} (weight {args.distill})")
     class_weight = torch.ones(cfg.content_classes, device=args.device)
     class_weight[[PHONE_INDEX[p] for p in BILABIALS]] = args.bilabial_weight
     opt = torch.optim.AdamW(enc.parameters(), lr=args.lr, weight_decay=1e-4)
@@ -267,7 +291,8 @@ def main(argv=None) -> int:
         if args.consistency:
             crop, lab = bank.crops(rng, args.batch, cfg.content_stride)
             views = [timbre(warp(crop, warp_factors(rng, args.batch, crop.device)), rng, args.timbre) for _ in range(2)]
-            logits = forward_augmented(enc, torch.cat(views), rng)
+            mel = torch.cat(views)
+            logits = forward_augmented(enc, mel, rng)
             lab = torch.cat([lab, lab])
         else:
             mel, lab = bank.batch(rng, args.batch, cfg.content_stride)
@@ -277,6 +302,10 @@ def main(argv=None) -> int:
         loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=PAD_LABEL)
         if args.consistency:
             loss = loss + args.consistency * view_disagreement(logits[:, :k], lab[:, :k] != PAD_LABEL)
+        if teacher is not None:
+            with torch.no_grad():
+                heard_by_teacher = teacher(mel)
+            loss = loss + args.distill * distillation(logits[:, :k], heard_by_teacher, lab[:, :k] != PAD_LABEL)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
