@@ -85,8 +85,8 @@ export class DecoderPool {
     return this.workers.length;
   }
 
-  /** tokens (F x N x d), poseToken (F x d) -> offsets (F x N x 3), pose (F x 6), as FastDecoder.decode. */
-  async decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
+  /** latents (F x 2d), poseToken (F x d) -> offsets (F x N x 3), pose (F x 6), as FastDecoder.decodeLatents. */
+  async decode(latents: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
     if (this.failed) throw this.failed;
     const { n, d } = this;
     const parts = Math.min(this.workers.length, frames);
@@ -96,9 +96,9 @@ export class DecoderPool {
       const id = this.nextId++;
       return new Promise<{ offsets: Float32Array; pose: Float32Array }>((resolve, reject) => {
         this.pending.set(id, { resolve, reject });
-        const t = tokens.slice(a * n * d, b * n * d);
+        const l = latents.slice(a * 2 * d, b * 2 * d);
         const p = poseToken.slice(a * d, b * d);
-        this.workers[i].postMessage({ type: 'decode', id, tokens: t, poseToken: p, frames: b - a }, [t.buffer, p.buffer]);
+        this.workers[i].postMessage({ type: 'decode', id, latents: l, poseToken: p, frames: b - a }, [l.buffer, p.buffer]);
       });
     }));
     const offsets = new Float32Array(frames * n * 3);

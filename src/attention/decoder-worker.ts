@@ -17,7 +17,7 @@ interface Init {
 interface Job {
   type: 'decode';
   id: number;
-  tokens: Float32Array;
+  latents: Float32Array;
   poseToken: Float32Array;
   frames: number;
 }
@@ -33,7 +33,7 @@ self.onmessage = (e: MessageEvent<Init | Job>) => {
       return;
     }
     if (!decoder) throw new Error('decoder worker: decode before init');
-    const out = decoder.decode(msg.tokens, msg.poseToken, msg.frames);
+    const out = decoder.decodeLatents(msg.latents, msg.poseToken, msg.frames);
     (self as unknown as Worker).postMessage({ type: 'done', id: msg.id, offsets: out.offsets, pose: out.pose }, [out.offsets.buffer, out.pose.buffer]);
   } catch (err) {
     self.postMessage({ type: 'error', id: (msg as Job).id ?? -1, message: (err as Error).message });

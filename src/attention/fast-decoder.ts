@@ -37,6 +37,8 @@ export class FastDecoder {
   private readonly rows: number;
   private readonly kernel: DecoderKernel;
   private readonly layers: PackedLayer[];
+  private readonly vertexEmbedding: Float32Array;
+  private readonly localOut: PackedWeight;
   private readonly lnG: Float32Array;
   private readonly lnB: Float32Array;
   private readonly x: Float32Array;
@@ -69,8 +71,8 @@ export class FastDecoder {
     if (simd) {
       const L = weights.layers.length;
       const floats = rows * (6 * d + m.ffn) + L * (4 * d * d + 2 * d * m.ffn + 8 * d + m.ffn) + 2 * d
-        + lists.keyStart.length + lists.keys.length + SimdKernel.scratchFloats(n + 1);
-      const allocations = 8 + 14 * L;
+        + n * d + d * d + d + lists.keyStart.length + lists.keys.length + SimdKernel.scratchFloats(n + 1);
+      const allocations = 11 + 14 * L;
       this.kernel = new SimdKernel(4 * floats + 16 * allocations);
     } else {
       this.kernel = jsKernel;
@@ -89,6 +91,11 @@ export class FastDecoder {
       ffn1: k.pack(L.ffn1W, L.ffn1B, m.ffn, d),
       ffn2: k.pack(L.ffn2W, L.ffn2B, d, m.ffn),
     }));
+    if (weights.vertexEmbedding.length !== n * d) {
+      throw new Error(`FastDecoder: the vertex embedding has ${weights.vertexEmbedding.length / d} vertices, the template ${n}`);
+    }
+    this.vertexEmbedding = k.place(weights.vertexEmbedding);
+    this.localOut = k.pack(weights.localOutW, weights.localOutB, d, d);
     this.lnG = k.place(weights.lnG);
     this.lnB = k.place(weights.lnB);
     this.scores = k.scratch(n + 1);
@@ -108,6 +115,51 @@ export class FastDecoder {
       this.heads(offsets, pose, f);
     }
     return { offsets, pose };
+  }
+
+  /**
+   * latents (F x 2d: each frame's [a, g], hierarchical.onnx's output), poseToken (F x d) -> as decode. The vertex
+   * tokens are made here, in the decoder's arithmetic: localOut(gelu(a + e_j)) + g (reference.ts vertexTokens).
+   */
+  decodeLatents(latents: Float32Array, poseToken: Float32Array, frames: number): DecodeResult {
+    const { n, d } = this;
+    const offsets = new Float32Array(frames * n * 3);
+    const pose = new Float32Array(frames * 6);
+    for (let f = 0; f < frames; f++) {
+      this.vertexTokensOf(latents, f);
+      this.x.set(poseToken.subarray(f * d, (f + 1) * d), n * d);
+      for (const L of this.layers) this.layer(L);
+      this.heads(offsets, pose, f);
+    }
+    return { offsets, pose };
+  }
+
+  /** The vertex tokens (F x N x d) of frames' latents, as decodeLatents makes them (for a decoder that takes tokens). */
+  vertexTokens(latents: Float32Array, frames: number): Float32Array {
+    const { n, d } = this;
+    const tokens = new Float32Array(frames * n * d);
+    for (let f = 0; f < frames; f++) {
+      this.vertexTokensOf(latents, f);
+      tokens.set(this.x.subarray(0, n * d), f * n * d);
+    }
+    return tokens;
+  }
+
+  /** Frame f's vertex tokens into x's first N rows (h is scratch). */
+  private vertexTokensOf(latents: Float32Array, f: number): void {
+    const { n, d, h, x, rows, vertexEmbedding: e, kernel: k } = this;
+    const a = f * 2 * d, g = a + d;
+    for (let j = 0; j < n; j++) {
+      const r = j * d;
+      for (let i = 0; i < d; i++) h[r + i] = e[r + i] + latents[a + i];
+    }
+    h.fill(0, n * d, rows * d);
+    k.gelu(h, n * d);
+    k.matmul(this.localOut, h, rows, x);
+    for (let j = 0; j < n; j++) {
+      const r = j * d;
+      for (let i = 0; i < d; i++) x[r + i] += latents[g + i];
+    }
   }
 
   private layer(L: PackedLayer): void {

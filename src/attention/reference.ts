@@ -25,6 +25,12 @@ export interface DecoderWeights {
   lnG: Float32Array; lnB: Float32Array;
   dispW: Float32Array; dispB: Float32Array; // (3 x d)
   poseW: Float32Array; poseB: Float32Array; // (6 x d)
+  /**
+   * The hierarchical feature's per-vertex part (paper Sec. III-C): vertex j's token is
+   * localOut(gelu(a + e_j)) + g, from the frame's latents [a, g] (hierarchical.onnx). e: (N x d).
+   */
+  vertexEmbedding: Float32Array;
+  localOutW: Float32Array; localOutB: Float32Array; // (d x d), (d)
   /** The LayerNorms' epsilon (manifest.model.layer_norm_eps). */
   lnEps: number;
 }
@@ -50,8 +56,30 @@ export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants, eps: n
     lnG: f32(t, 'decoder.ln.weight', [d]), lnB: f32(t, 'decoder.ln.bias', [d]),
     dispW: f32(t, 'displacement_head.weight', [3, d]), dispB: f32(t, 'displacement_head.bias', [3]),
     poseW: f32(t, 'pose_head.weight', [6, d]), poseB: f32(t, 'pose_head.bias', [6]),
+    vertexEmbedding: f32(t, 'hierarchical.vertex_embedding', [t.get('hierarchical.vertex_embedding')?.shape[0] ?? 0, d]),
+    localOutW: f32(t, 'hierarchical.local_out.weight', [d, d]), localOutB: f32(t, 'hierarchical.local_out.bias', [d]),
     lnEps: eps,
   };
+}
+
+/**
+ * The vertex tokens (F x N x d) of frames' hierarchical latents (F x 2d: [a, g], hierarchical.onnx's output):
+ * token j = localOut(gelu(a + e_j)) + g, exact GELU. The readable form FastDecoder.decodeLatents is held to.
+ */
+export function vertexTokens(w: DecoderWeights, latents: Float32Array, frames: number, d: number): Float32Array {
+  const n = w.vertexEmbedding.length / d;
+  const tokens = new Float32Array(frames * n * d);
+  const h = new Float32Array(d);
+  for (let f = 0; f < frames; f++) {
+    const a = f * 2 * d, g = a + d;
+    for (let j = 0; j < n; j++) {
+      for (let i = 0; i < d; i++) h[i] = gelu(latents[a + i] + w.vertexEmbedding[j * d + i]);
+      const o = (f * n + j) * d;
+      linear(w.localOutW, w.localOutB, d, d, h, 0, tokens, o);
+      for (let i = 0; i < d; i++) tokens[o + i] += latents[g + i];
+    }
+  }
+  return tokens;
 }
 
 /** erf by Abramowitz & Stegun 7.1.26 (|error| < 1.5e-7); the WGSL kernel uses the same formula. */

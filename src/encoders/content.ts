@@ -1,7 +1,8 @@
 /**
  * The content branch (paper Fig. 2, "audio encoder"): log-Mel -> content encoder (ONNX, phone logits every
  * content_stride Mel frames) -> softmax -> each animation frame's window of posteriors -> the hierarchical
- * encoder (ONNX) -> one token per vertex. The model's stand-in for DeepSpeech: what it heard, per frame.
+ * encoder (ONNX) -> its latents, of which the decoder makes one token per vertex. The model's stand-in for
+ * DeepSpeech: what it heard, per frame.
  */
 import type { Manifest, ModelConstants } from '../model/manifest';
 import { contentWindows, softmaxRows } from './windows';
@@ -138,9 +139,12 @@ export class ContentEncoder {
     return speechProbabilities(post, this.m.content_classes, this.silence, melIndex.map((k) => Math.floor(k / this.m.content_stride) - r.lo), level, flatness);
   }
 
-  /** The hierarchical encoder: windows (frames x window x classes) -> vertex tokens (frames x N x d). */
-  async tokens(windows: Float32Array, frames: number): Promise<Float32Array> {
+  /**
+   * The hierarchical encoder's part that is one per frame: windows (frames x window x classes) -> latents
+   * (frames x 2d, [a, g]); the decoder makes each vertex's token of them (reference.ts vertexTokens).
+   */
+  async latents(windows: Float32Array, frames: number): Promise<Float32Array> {
     const m = this.m;
-    return (await this.hierarchical.run({ windows: { data: windows, shape: [frames, m.window, m.content_classes] } })).tokens.data;
+    return (await this.hierarchical.run({ windows: { data: windows, shape: [frames, m.window, m.content_classes] } })).latents.data;
   }
 }

@@ -84,11 +84,16 @@ export class DecoderBackends {
     return this.pool?.kernel ?? this.cpu.kernelName;
   }
 
-  /** Offsets and poses of `frames` frames from their vertex tokens and pose tokens. */
-  async decode(tokens: Float32Array, poseToken: Float32Array, frames: number, vertices: number): Promise<DecodeResult> {
+  /** The vertex tokens (F x N x d) of frames' hierarchical latents (F x 2d), as the decoders make them. */
+  vertexTokens(latents: Float32Array, frames: number): Float32Array {
+    return this.cpu.vertexTokens(latents, frames);
+  }
+
+  /** Offsets and poses of `frames` frames from their hierarchical latents (F x 2d) and pose tokens. */
+  async decode(latents: Float32Array, poseToken: Float32Array, frames: number, vertices: number): Promise<DecodeResult> {
     if (this.gpu) {
       try {
-        return await this.decodeOnGpu(this.gpu, tokens, poseToken, frames, vertices);
+        return await this.decodeOnGpu(this.gpu, latents, poseToken, frames, vertices);
       } catch (e) {
         // The animation goes on: switch to the CPU decoder for this and every later chunk.
         this.gpu.destroy();
@@ -99,7 +104,7 @@ export class DecoderBackends {
     }
     if (this.pool && frames > 1) {
       try {
-        return await this.pool.decode(tokens, poseToken, frames);
+        return await this.pool.decode(latents, poseToken, frames);
       } catch (e) {
         // A crashed worker: decode in this thread from now on (same numbers), and say so.
         this.pool.terminate();
@@ -107,16 +112,17 @@ export class DecoderBackends {
         this.reason += `; the decoder workers failed (${(e as Error).message}), decoding in the page's thread`;
       }
     }
-    return this.cpu.decode(tokens, poseToken, frames);
+    return this.cpu.decodeLatents(latents, poseToken, frames);
   }
 
-  private async decodeOnGpu(gpu: GpuDecoder, tokens: Float32Array, poseToken: Float32Array, frames: number, n: number): Promise<DecodeResult> {
+  private async decodeOnGpu(gpu: GpuDecoder, latents: Float32Array, poseToken: Float32Array, frames: number, n: number): Promise<DecodeResult> {
     const out: DecodeResult = { offsets: new Float32Array(frames * n * 3), pose: new Float32Array(frames * 6) };
     const step = gpu.maxFrames;
     const d = this.m.d_model;
     for (let i = 0; i < frames; i += step) {
       const j = Math.min(frames, i + step);
-      const r = await gpu.decode(tokens.subarray(i * n * d, j * n * d), poseToken.subarray(i * d, j * d), j - i);
+      const tokens = this.cpu.vertexTokens(latents.subarray(i * 2 * d, j * 2 * d), j - i);
+      const r = await gpu.decode(tokens, poseToken.subarray(i * d, j * d), j - i);
       out.offsets.set(r.offsets, i * n * 3);
       out.pose.set(r.pose, i * 6);
     }

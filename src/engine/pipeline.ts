@@ -133,7 +133,7 @@ export class Pipeline {
     this.times.content += performance.now() - t;
 
     t = performance.now();
-    const tokens = await this.content.tokens(windows, melIndex.length);
+    const latents = await this.content.latents(windows, melIndex.length);
     this.times.hierarchical += performance.now() - t;
 
     // Pose: the LSTM advances over every Mel frame up to this chunk's last one, exactly once.
@@ -146,11 +146,11 @@ export class Pipeline {
     this.times.pose += performance.now() - t;
 
     if (inputs) {
-      inputs.tokens = tokens;
+      inputs.tokens = this.decoders.vertexTokens(latents, melIndex.length);
       inputs.poseToken = poseToken;
     }
     t = performance.now();
-    const decoded = await this.decoders.decode(tokens, poseToken, melIndex.length, this.template.vertexCount);
+    const decoded = await this.decoders.decode(latents, poseToken, melIndex.length, this.template.vertexCount);
     this.times.decoder += performance.now() - t;
 
     t = performance.now();

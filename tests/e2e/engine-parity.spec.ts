@@ -17,6 +17,7 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder (WebAssembly SIMD a
   for (const kernel of ['wasm-simd', 'js']) {
     expect(r[`fast_${kernel}_VsCpuOffsets`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-4);
     expect(r[`fast_${kernel}_VsCpuPose`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-5);
+    expect(r[`fast_${kernel}_TokensVsTorch`] as number, `vertex tokens of the latents, ${kernel}`).toBeLessThan(1e-5);
   }
   expect(r.cpuVsTorchOffsets as number).toBeLessThan(1e-4);
   expect(r.cpuVsTorchPose as number).toBeLessThan(1e-5);

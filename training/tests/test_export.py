@@ -32,8 +32,15 @@ def test_onnx_encoders_equal_pytorch(exported):
     mel = fx["mel"][None]
     logits = session(out / "content_encoder.onnx").run(None, {"mel": mel})[0]
     np.testing.assert_allclose(logits[0], fx["content_logits"], atol=1e-5)
-    tokens = session(out / "hierarchical.onnx").run(None, {"windows": fx["windows"]})[0]
-    np.testing.assert_allclose(tokens[: fx["tokens"].shape[0]], fx["tokens"], atol=1e-5)
+    latents = session(out / "hierarchical.onnx").run(None, {"windows": fx["windows"]})[0]
+    np.testing.assert_allclose(latents, fx["hierarchical_latents"], atol=1e-5)
+    # the vertex tokens the browser's decoder makes of them, with gava.safetensors' per-vertex tensors
+    w = read_safetensors(out / "gava.safetensors")
+    d = model.cfg.d_model
+    a, g = torch.from_numpy(latents[:, None, :d]), torch.from_numpy(latents[:, None, d:])
+    h = torch.nn.functional.gelu(a + torch.from_numpy(w["hierarchical.vertex_embedding"]))
+    tokens = h @ torch.from_numpy(w["hierarchical.local_out.weight"]).T + torch.from_numpy(w["hierarchical.local_out.bias"]) + g
+    np.testing.assert_allclose(tokens[: fx["tokens"].shape[0]].numpy(), fx["tokens"], atol=1e-5)
     conv = session(out / "pose_conv.onnx").run(None, {"mel": mel})[0]
     np.testing.assert_allclose(conv[0], fx["pose_conv"], atol=1e-5)
     C = model.cfg.pose_channels

@@ -2,7 +2,7 @@
 import { describe, expect, it } from 'vitest';
 import type { Manifest } from '../../../src/model/manifest';
 import { f32 } from '../../../src/model/safetensors';
-import { ReferenceDecoder, gelu } from '../../../src/attention/reference';
+import { ReferenceDecoder, gelu, vertexTokens } from '../../../src/attention/reference';
 import { FastDecoder, geluInPlace, matmulRows } from '../../../src/attention/fast-decoder';
 import { loadDecoderWeights, loadFixtures, loadManifest, loadTemplateFile, maxAbsDiff } from '../helpers/exported';
 
@@ -26,6 +26,28 @@ describe('the fast decoder vs the PyTorch fixture', () => {
     expect(maxAbsDiff(fast.pose, ref.pose)).toBeLessThan(1e-5);
     // Decoding again reuses the buffers: the same numbers.
     expect(maxAbsDiff(decoder.decode(tokens, poseTok, frames).offsets, fast.offsets)).toBe(0);
+  });
+
+  it.each(['js', 'wasm-simd'] as const)('the fast decoder (%s) makes the vertex tokens of the hierarchical latents as PyTorch and the reference do', async (kernel) => {
+    const m = manifest.model.config;
+    const template = await loadTemplateFile(manifest);
+    const weights = loadDecoderWeights(manifest);
+    const frames = manifest.fixtures.token_frames;
+    const latents = f32(fx, 'hierarchical_latents'), poseTok = f32(fx, 'pose_token');
+    const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
+    const tokens = decoder.vertexTokens(latents, frames);
+    const scale = f32(fx, 'tokens').reduce((s, v) => Math.max(s, Math.abs(v)), 0);
+    expect(scale).toBeGreaterThan(0.1);
+    expect(maxAbsDiff(tokens, f32(fx, 'tokens'))).toBeLessThan(1e-5 * Math.max(1, scale));
+    expect(maxAbsDiff(tokens, vertexTokens(weights, latents, frames, m.d_model))).toBeLessThan(1e-5 * Math.max(1, scale));
+    // decodeLatents is decode of those tokens, to the bit, and matches PyTorch's every frame of the clip
+    const all = manifest.fixtures.frames;
+    const fromLatents = decoder.decodeLatents(latents, poseTok, all);
+    const fromTokens = decoder.decode(decoder.vertexTokens(latents, all), poseTok, all);
+    expect(maxAbsDiff(fromLatents.offsets, fromTokens.offsets)).toBe(0);
+    expect(maxAbsDiff(fromLatents.pose, fromTokens.pose)).toBe(0);
+    expect(maxAbsDiff(fromLatents.offsets, f32(fx, 'offsets'))).toBeLessThan(1e-4);
+    expect(maxAbsDiff(fromLatents.pose, f32(fx, 'pose'))).toBeLessThan(1e-5);
   });
 
   it('the engine\'s default CPU decoder here is the SIMD one', async () => {

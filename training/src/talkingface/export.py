@@ -4,7 +4,9 @@
 
 Writes
   content_encoder.onnx   log-Mel (1, K, n_mels) -> phone logits (1, Kc, D)
-  hierarchical.onnx      posterior windows (F, W, D) -> vertex tokens (F, N, d)
+  hierarchical.onnx      posterior windows (F, W, D) -> the frame's hierarchical latents (F, 2d): [a, g], a = the local
+                         MLP's first layer, g = the global MLP; the decoder makes the vertex tokens of them
+                         (f_h,j = local_out(gelu(a + e_j)) + g, e and local_out in gava.safetensors)
   pose_conv.onnx         log-Mel (1, K, n_mels) -> conv features (1, K, C)      (no state: recompute with context)
   pose_lstm.onnx         conv features + (h, c) -> pose features (1, K, d) + (h, c)   (streams chunk by chunk)
   gava.safetensors       the attention layers and the heads (the browser's WGSL / TypeScript decoder reads these)
@@ -41,16 +43,40 @@ MANIFEST_FORMAT = "talking-face-model"
 OPSET = 17
 
 
-class _Hierarchical(nn.Module):
-    """The hierarchical feature for the exported face: its shape input (template_input models) baked in."""
+class _HierarchicalLatents(nn.Module):
+    """The part of the hierarchical feature that is one per frame, [a, g] (F, 2d): a = local_in(window), g = the
+    global MLP (zeros for a part the model lacks). The per-vertex part, local_out(gelu(a + e_j)) + g, is N times the
+    work and N times the bytes; the browser's decoder computes it (vertex_token_tensors), so only 2d numbers a frame
+    leave onnxruntime."""
 
-    def __init__(self, model, template_mm: torch.Tensor):
+    def __init__(self, model):
         super().__init__()
-        self.hierarchical = model.hierarchical
-        self.register_buffer("delta", model.template_delta(template_mm))
+        self.h = model.hierarchical
+        self.d = model.cfg.d_model
 
     def forward(self, window):
-        return self.hierarchical(window, self.delta)
+        flat = window.flatten(1)
+        zeros = flat.new_zeros(flat.shape[0], self.d)
+        a = self.h.local_in(flat) if self.h.use_local else zeros
+        g = self.h.global_mlp(flat) if self.h.use_global else zeros
+        return torch.cat([a, g], 1)
+
+
+def vertex_token_tensors(model, template_mm: torch.Tensor) -> dict[str, np.ndarray]:
+    """The per-vertex part of the hierarchical feature, for the browser's decoder: e_j (N, d; with a template_input
+    model's shape term for the template baked in, as the model computes it for that face) and local_out. A model
+    without the local part gets zeros, so that its tokens are g alone, as the model's."""
+    h, d, n = model.hierarchical, model.cfg.d_model, model.num_vertices
+    if h.use_local:
+        e = h.vertex_embedding.detach()
+        if h.shape_in is not None:
+            e = e + h.shape_in(model.template_delta(template_mm))[0].detach()
+        w, b = h.local_out.weight.detach(), h.local_out.bias.detach()
+    else:
+        e, w, b = torch.zeros(n, d), torch.zeros(d, d), torch.zeros(d)
+    return {"hierarchical.vertex_embedding": e.numpy().astype(np.float32),
+            "hierarchical.local_out.weight": w.numpy().astype(np.float32),
+            "hierarchical.local_out.bias": b.numpy().astype(np.float32)}
 
 
 class _PoseLSTM(nn.Module):
@@ -164,9 +190,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
     _onnx(model.content, (mel,), out / "content_encoder.onnx", ["mel"], ["logits"], {"mel": {1: "K"}, "logits": {1: "Kc"}})
     files["content_encoder"] = "content_encoder.onnx"
     win = torch.rand(3, cfg.window, cfg.content_classes)
-    hierarchical = _Hierarchical(model, torch.from_numpy(template.vertices * template.to_millimetres()).float()[None]) \
-        if model.shape_input else model.hierarchical
-    _onnx(hierarchical, (win,), out / "hierarchical.onnx", ["windows"], ["tokens"], {"windows": {0: "F"}, "tokens": {0: "F"}})
+    _onnx(_HierarchicalLatents(model), (win,), out / "hierarchical.onnx", ["windows"], ["latents"], {"windows": {0: "F"}, "latents": {0: "F"}})
     files["hierarchical"] = "hierarchical.onnx"
     _onnx(_PoseConv(model.pose_encoder), (mel,), out / "pose_conv.onnx", ["mel"], ["conv"], {"mel": {1: "K"}, "conv": {1: "K"}})
     files["pose_conv"] = "pose_conv.onnx"
@@ -181,7 +205,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
           ["mel", "mel_index", "template"], ["vertices", "offsets", "pose"],
           {"mel": {1: "K"}, "mel_index": {1: "T"}, "vertices": {1: "T"}, "offsets": {1: "T"}, "pose": {1: "T"}})
     files["dense_model"] = "gava_dense.onnx"
-    weights = decoder_tensors(model)
+    weights = decoder_tensors(model) | vertex_token_tensors(model, tpl.float())
     head = HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck else None
     if head is not None:  # the head's own motion: read by src/pose/head-motion.ts from the same file
         weights |= {f"head_motion.{k}": np.asarray(v, np.float32) for k, v in head.to_dict().items()}
@@ -210,7 +234,9 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
         "template": {"id": template.id, "units": template.units, "mm_per_unit": mm_per_unit, "vertices": template.num_vertices,
                      "path": "template/template.json",
                      "model_units": "mm (positions are multiplied by the template's mm per unit before the model)"},
-        "tokens": {"count": "N + 1", "pose_token_index": template.num_vertices, "d_model": cfg.d_model, "heads": cfg.heads, "layers": cfg.layers,
+        "tokens": {"count": "N + 1", "pose_token_index": template.num_vertices,
+                   "vertex_tokens": "f_h,j = local_out(gelu(a + e_j)) + g per frame, [a, g] = hierarchical.onnx's latents, e_j and "
+                                    "local_out = hierarchical.* in gava.safetensors (exact GELU)", "d_model": cfg.d_model, "heads": cfg.heads, "layers": cfg.layers,
                    "mask": "vertex j attends to itself and its 1-ring (template adjacency); the pose token attends to all; no vertex attends to the pose token"},
         "head_motion": ({"tensors": "head_motion.* in gava.safetensors", "default_seed": 0,
                          "process": "residual_t = A f_t + c + r_t, r_t = a1 r_(t-1) + a2 r_(t-2) + g softplus(W f_t + b) z_t per axis (degrees, rotation vector); f_t the pose token; A, c: speech_w, speech_b; z_t = normal(seed, t, axis); R' = R_r R, t' = R_r (t - pivot) + pivot"}
@@ -227,7 +253,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
         "runtime_files": runtime,
         "onnx": {name: {"inputs": ins, "outputs": outs} for name, ins, outs in [
             ("content_encoder", {"mel": ["1", "K", a.n_mels]}, {"logits": ["1", "ceil(K / content_stride)", cfg.content_classes]}),
-            ("hierarchical", {"windows": ["F", cfg.window, cfg.content_classes]}, {"tokens": ["F", template.num_vertices, cfg.d_model]}),
+            ("hierarchical", {"windows": ["F", cfg.window, cfg.content_classes]}, {"latents": ["F", 2 * cfg.d_model]}),
             ("pose_conv", {"mel": ["1", "K", a.n_mels]}, {"conv": ["1", "K", C]}),
             ("pose_lstm", {"conv": ["1", "K", C], "h0": [1, 1, C], "c0": [1, 1, C]}, {"pose_features": ["1", "K", cfg.d_model], "hn": [1, 1, C], "cn": [1, 1, C]}),
             ("dense_model", {"mel": ["1", "K", a.n_mels], "mel_index": ["1", "T"], "template": ["1", template.num_vertices, 3]},

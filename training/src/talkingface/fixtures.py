@@ -19,6 +19,11 @@ FIXTURE_SECONDS = 0.6     # a short clip keeps the fixtures small
 FIXTURE_TOKEN_FRAMES = 2  # frames whose tokens and per-layer outputs are kept
 
 
+def _latents(model: TalkingFace, windows: torch.Tensor) -> torch.Tensor:
+    from .export import _HierarchicalLatents
+    return _HierarchicalLatents(model)(windows)
+
+
 @torch.no_grad()
 def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path, head_motion=None,
                    lip_closure=None) -> dict:
@@ -34,6 +39,7 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     mel_index = torch.from_numpy(frame_to_mel_index(np.arange(n_frames), a)).clamp(max=mel.shape[0] - 1)
     windows = model.content_windows(logits, mel_index[None])[0]                # (F, W, D)
     tokens = model.hierarchical(windows)                                       # (F, N, d)
+    latents = _latents(model, windows)                                         # (F, 2d): what hierarchical.onnx gives
     conv = model.pose_encoder.conv(model.pose_encoder.norm(mel_t).transpose(1, 2)).transpose(1, 2)
     pose_feat, _ = model.pose_encoder(mel_t)                                   # (1, K, d)
     pose_token = pose_feat[0, mel_index]                                       # (F, d)
@@ -50,7 +56,7 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     vertices = apply_pose(torch.from_numpy(template_mm)[None] + offsets, pose)
     tensors = {
         "audio": audio.astype(np.float32), "mel": mel, "content_logits": logits[0].numpy(), "mel_index": mel_index.numpy(),
-        "windows": windows.numpy(), "tokens": tokens[:FIXTURE_TOKEN_FRAMES].numpy(), "pose_conv": conv[0].numpy(),
+        "windows": windows.numpy(), "hierarchical_latents": latents.numpy(), "tokens": tokens[:FIXTURE_TOKEN_FRAMES].numpy(), "pose_conv": conv[0].numpy(),
         "pose_features": pose_feat[0].numpy(), "pose_token": pose_token.numpy(), "template_mm": template_mm.astype(np.float32),
         "offsets": offsets.numpy(), "pose": pose.numpy(), "vertices": vertices.numpy(),
     }

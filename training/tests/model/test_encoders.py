@@ -36,3 +36,26 @@ def test_the_shape_input_reads_how_the_face_differs_from_the_reference(make, tem
     a, b = model.animate(mel, ref[0], 40), model.animate(mel, other[0], 40)
     assert (a["offsets"] - b["offsets"]).abs().max() > 1e-3                   # the face changes what the model does
     assert not make().shape_input and not make(template_input=True, features="G").shape_input
+
+
+def test_the_exported_split_of_the_hierarchical_feature_makes_the_same_tokens(make, template):
+    """hierarchical.onnx gives [a, g] per frame and the browser's decoder makes the vertex tokens of them with
+    gava.safetensors' e_j and local_out (export.vertex_token_tensors): the same tokens as the model's, for every
+    kind of feature and with the shape input baked in for the template's face."""
+    from talkingface.export import _HierarchicalLatents, vertex_token_tensors
+    ref = torch.from_numpy(template.vertices * template.to_millimetres()).float()[None]
+    for options in ({}, {"features": "L"}, {"features": "G"}, {"template_input": True}):
+        model = make(**options)
+        if model.shape_input:
+            torch.nn.init.normal_(model.hierarchical.shape_in.weight)
+            torch.nn.init.normal_(model.hierarchical.shape_in.bias)
+        d = model.cfg.d_model
+        win = torch.rand(3, model.cfg.window, model.cfg.content_classes)
+        with torch.no_grad():
+            latents = _HierarchicalLatents(model)(win)
+            want = model.hierarchical(win, model.template_delta(ref) if model.shape_input else None)
+        w = {k: torch.from_numpy(v) for k, v in vertex_token_tensors(model, ref).items()}
+        h = torch.nn.functional.gelu(latents[:, None, :d] + w["hierarchical.vertex_embedding"])
+        tokens = h @ w["hierarchical.local_out.weight"].T + w["hierarchical.local_out.bias"] + latents[:, None, d:]
+        assert latents.shape == (3, 2 * d), options
+        torch.testing.assert_close(tokens, want, rtol=0, atol=1e-5, msg=str(options))
