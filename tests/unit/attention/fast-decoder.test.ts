@@ -48,6 +48,11 @@ describe('the fast decoder vs the PyTorch fixture', () => {
     expect(maxAbsDiff(fromLatents.pose, fromTokens.pose)).toBe(0);
     expect(maxAbsDiff(fromLatents.offsets, f32(fx, 'offsets'))).toBeLessThan(1e-4);
     expect(maxAbsDiff(fromLatents.pose, f32(fx, 'pose'))).toBeLessThan(1e-5);
+    // weights of another mesh: tokens still decode, latents are refused with the reason
+    const other = { ...weights, vertexEmbedding: weights.vertexEmbedding.subarray(0, 10 * m.d_model) };
+    const mismatched = new FastDecoder(other, template.adjacency, m, kernel);
+    expect(maxAbsDiff(mismatched.decode(f32(fx, 'tokens'), poseTok, frames).offsets, decoder.decode(f32(fx, 'tokens'), poseTok, frames).offsets)).toBe(0);
+    expect(() => mismatched.decodeLatents(latents, poseTok, frames)).toThrow(`10 vertices, the template ${template.adjacency.offsets.length - 1}`);
   });
 
   it('the engine\'s default CPU decoder here is the SIMD one', async () => {

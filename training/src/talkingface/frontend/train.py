@@ -34,6 +34,7 @@ from ..train import articulation as art
 from ..train.data import prepare
 from ..train.train import load_frontend
 from .bank import Bank, PAD_LABEL, spec_augment, timbre, unpack, warp, warp_factors
+from .losses import distillation, view_disagreement
 from .measure import load_encoder
 
 
@@ -104,25 +105,6 @@ def forward_augmented(enc: ContentEncoder, mel: torch.Tensor, rng) -> torch.Tens
         return enc(x)
     finally:
         enc.norm = identity
-
-
-def view_disagreement(logits: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
-    """Symmetric KL divergence between the posteriors of a batch's two views (its halves), over the frames that
-    are speech in both. logits (2B, K, D), real (2B, K) -> a scalar."""
-    a, b = logits.log_softmax(-1).chunk(2)
-    kl = (a.exp() * (a - b) + b.exp() * (b - a)).sum(-1) / 2                  # (B, K)
-    m = real.chunk(2)[0]
-    return (kl * m).sum() / m.sum().clamp(min=1)
-
-
-def distillation(logits: torch.Tensor, teacher: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
-    """KL divergence from a teacher's log-posteriors to the student's, over the frames that are not padding.
-    logits (B, K, D) the student's, teacher (B, K', D) log-posteriors, real (B, K) -> a scalar."""
-    k = min(logits.shape[1], teacher.shape[1], real.shape[1])
-    s, t = logits[:, :k].log_softmax(-1), teacher[:, :k]
-    kl = (t.exp() * (t - s)).sum(-1)
-    m = real[:, :k].float()
-    return (kl * m).sum() / m.sum().clamp(min=1)
 
 
 @torch.no_grad()
