@@ -42,6 +42,11 @@ export class DecoderBackends {
 
   static async create(weights: DecoderWeights, adjacency: Adjacency, m: ModelConstants, support: WebGPUSupport, gpuFrames: number,
     options: BackendOptions = {}): Promise<DecoderBackends> {
+    const n = adjacency.offsets.length - 1;
+    if (weights.vertexEmbedding.length !== n * m.d_model) {
+      throw new ModelLoadError(`the model's vertex embedding has ${weights.vertexEmbedding.length / m.d_model} vertices, its template ${n}: `
+        + 'the decoder weights and the template are of different meshes');
+    }
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';

@@ -1,6 +1,7 @@
 /**
- * One chunk of the pipeline (paper Fig. 2): samples -> log-Mel -> content encoder -> windows -> hierarchical
- * tokens; log-Mel -> pose encoder (state carried) -> pose token; both -> the attention decoder -> posing.
+ * One chunk of the pipeline (paper Fig. 2): samples -> log-Mel -> content encoder -> windows -> the hierarchical
+ * feature's latents; log-Mel -> pose encoder (state carried) -> pose token; both -> the attention decoder (which
+ * makes the vertex tokens of the latents) -> posing.
  *
  * Every chunk recomputes the Mel and content frames it needs with enough context on each side that the result
  * equals the whole-clip computation exactly, so memory holds one chunk of intermediates whatever the clip's length.

@@ -4,6 +4,8 @@
  */
 
 export const MANIFEST_FORMAT = 'talking-face-model';
+/** 2: hierarchical.onnx gives each frame's latents and the decoder makes the vertex tokens (gava.safetensors' hierarchical.*). */
+export const MANIFEST_VERSION = 2;
 
 /** Where the app, the element and the dev pages find the shipped model (models/ is served at /models/). */
 export const DEFAULT_MANIFEST_URL = '/models/manifest.json';
@@ -66,7 +68,10 @@ export class ManifestError extends Error {
 export function checkManifest(m: unknown): Manifest {
   const x = m as Manifest;
   if (!x || x.format !== MANIFEST_FORMAT) throw new ManifestError(`not a talking-face model manifest (expected "format": "${MANIFEST_FORMAT}")`);
-  if (x.version !== 1) throw new ManifestError(`model manifest version ${x.version} is not supported by this build (1)`);
+  if (x.version !== MANIFEST_VERSION) {
+    throw new ManifestError(`model manifest version ${x.version} is not supported by this build (${MANIFEST_VERSION}): `
+      + 're-export the model with this build\'s exporter');
+  }
   for (const key of ['sample_rate', 'frame_size', 'hop', 'n_mels', 'fps'] as const) {
     if (!Number.isFinite(x.audio?.[key])) throw new ManifestError(`model manifest lacks audio.${key}`);
   }

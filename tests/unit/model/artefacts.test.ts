@@ -3,6 +3,7 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
 import { fetchArtefacts, ModelLoadError } from '../../../src/model/artefacts';
+import { checkManifest, ManifestError } from '../../../src/model/manifest';
 
 const MODELS = resolve(import.meta.dirname, '../../../models');
 
@@ -25,6 +26,13 @@ describe('fetchArtefacts', () => {
     expect(pose.byteLength).toBe(readFileSync(resolve(MODELS, a.manifest.files.pose_conv)).length);
     expect((await a.template).id).toBe(a.manifest.template.id);
     await Promise.all(Object.values(a.files));
+  });
+
+  it('refuses a manifest of another version, saying to re-export (version 1 made the tokens in hierarchical.onnx)', () => {
+    const manifest = JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8'));
+    expect(checkManifest(manifest).version).toBe(2);
+    expect(() => checkManifest({ ...manifest, version: 1 })).toThrow(ManifestError);
+    expect(() => checkManifest({ ...manifest, version: 1 })).toThrow(/version 1 is not supported by this build \(2\): re-export/);
   });
 
   it('rejects only the corrupt file, with a message that names it', async () => {

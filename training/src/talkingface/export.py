@@ -40,6 +40,7 @@ from .safetensors import sha256, write_safetensors
 from .template import Template, load_template
 
 MANIFEST_FORMAT = "talking-face-model"
+MANIFEST_VERSION = 2  # 2: hierarchical.onnx gives the latents [a, g]; the browser's decoder makes the vertex tokens
 OPSET = 17
 
 
@@ -223,7 +224,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
     all_files = {**files, "fixtures": fixtures["file"]}
     runtime = ["content_encoder", "hierarchical", "pose_conv", "pose_lstm", "decoder_weights"]
     manifest = {
-        "format": MANIFEST_FORMAT, "version": 1,
+        "format": MANIFEST_FORMAT, "version": MANIFEST_VERSION,
         "model": {"name": cfg.name, "config": cfg.to_dict(), "trained_steps": ck["step"],
                   "trained_minutes": round(ck["trained_seconds"] / 60, 1), "parameters": int(sum(p.numel() for p in model.parameters())),
                   "layer_norm_eps": layer_norm_eps(model)},

@@ -1,4 +1,5 @@
 """The content encoder: the dilated one reads half a second back and no further ahead than the first one."""
+import numpy as np
 import torch
 
 from talkingface.model.config import ModelConfig
@@ -38,24 +39,33 @@ def test_the_shape_input_reads_how_the_face_differs_from_the_reference(make, tem
     assert not make().shape_input and not make(template_input=True, features="G").shape_input
 
 
-def test_the_exported_split_of_the_hierarchical_feature_makes_the_same_tokens(make, template):
+def test_the_exported_split_of_the_hierarchical_feature_makes_the_same_tokens(make, template, tmp_path):
     """hierarchical.onnx gives [a, g] per frame and the browser's decoder makes the vertex tokens of them with
     gava.safetensors' e_j and local_out (export.vertex_token_tensors): the same tokens as the model's, for every
-    kind of feature and with the shape input baked in for the template's face."""
-    from talkingface.export import _HierarchicalLatents, vertex_token_tensors
+    kind of feature, and with the shape input baked in for the face exported with (here not the reference face, so
+    that the shape term counts); the ONNX graph of the latents takes any number of frames."""
+    import onnxruntime as ort
+    from talkingface.export import _HierarchicalLatents, _onnx, vertex_token_tensors
     ref = torch.from_numpy(template.vertices * template.to_millimetres()).float()[None]
+    face = ref * 1.05
     for options in ({}, {"features": "L"}, {"features": "G"}, {"template_input": True}):
         model = make(**options)
         if model.shape_input:
             torch.nn.init.normal_(model.hierarchical.shape_in.weight)
             torch.nn.init.normal_(model.hierarchical.shape_in.bias)
         d = model.cfg.d_model
-        win = torch.rand(3, model.cfg.window, model.cfg.content_classes)
+        win = torch.rand(5, model.cfg.window, model.cfg.content_classes)
         with torch.no_grad():
             latents = _HierarchicalLatents(model)(win)
-            want = model.hierarchical(win, model.template_delta(ref) if model.shape_input else None)
-        w = {k: torch.from_numpy(v) for k, v in vertex_token_tensors(model, ref).items()}
+            want = model.hierarchical(win, model.template_delta(face) if model.shape_input else None)
+            if model.shape_input:  # the face's shape moves the tokens: a test of the term, not of its bias alone
+                assert (want - model.hierarchical(win, None)).abs().max() > 1e-3
+        w = {k: torch.from_numpy(v) for k, v in vertex_token_tensors(model, face).items()}
         h = torch.nn.functional.gelu(latents[:, None, :d] + w["hierarchical.vertex_embedding"])
         tokens = h @ w["hierarchical.local_out.weight"].T + w["hierarchical.local_out.bias"] + latents[:, None, d:]
-        assert latents.shape == (3, 2 * d), options
+        assert latents.shape == (5, 2 * d), options
         torch.testing.assert_close(tokens, want, rtol=0, atol=1e-5, msg=str(options))
+        path = tmp_path / "hierarchical.onnx"
+        _onnx(_HierarchicalLatents(model), (win[:3],), path, ["windows"], ["latents"], {"windows": {0: "F"}, "latents": {0: "F"}})
+        got = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"]).run(None, {"windows": win.numpy()})[0]
+        np.testing.assert_allclose(got, latents.numpy(), atol=1e-5, err_msg=str(options))
