@@ -93,7 +93,8 @@ export class FastDecoder {
     }));
     // Weights of another mesh decode tokens given (decode) but cannot make them (decodeLatents): the benchmark's larger meshes.
     this.vertexEmbedding = weights.vertexEmbedding.length === n * d ? k.place(weights.vertexEmbedding) : null;
-    this.localOut = k.pack(weights.localOutW, weights.localOutB, d, d);
+    // Its bias is rewritten every frame with localOutB + g (a copy: the TypeScript kernel packs the arrays it is given).
+    this.localOut = k.pack(weights.localOutW, weights.localOutB.slice(), d, d);
     this.lnG = k.place(weights.lnG);
     this.lnB = k.place(weights.lnB);
     this.scores = k.scratch(n + 1);
@@ -143,7 +144,7 @@ export class FastDecoder {
     return tokens;
   }
 
-  /** Frame f's vertex tokens into x's first N rows (h is scratch). */
+  /** Frame f's vertex tokens into x's first N rows (h is scratch): g rides in the product's bias. */
   private vertexTokensOf(latents: Float32Array, f: number): void {
     const { n, d, h, x, rows, vertexEmbedding: e, kernel: k } = this;
     if (!e) throw new Error(`FastDecoder: the vertex embedding has ${this.weights.vertexEmbedding.length / d} vertices, the template ${n}`);
@@ -154,11 +155,9 @@ export class FastDecoder {
     }
     h.fill(0, n * d, rows * d);
     k.gelu(h, n * d);
+    const bias = this.localOut.b;
+    for (let i = 0; i < d; i++) bias[i] = this.weights.localOutB[i] + latents[g + i];
     k.matmul(this.localOut, h, rows, x);
-    for (let j = 0; j < n; j++) {
-      const r = j * d;
-      for (let i = 0; i < d; i++) x[r + i] += latents[g + i];
-    }
   }
 
   private layer(L: PackedLayer): void {
