@@ -6,7 +6,7 @@
 import { checkManifest, DEFAULT_MANIFEST_URL } from '../src/model/manifest';
 import { parseSafetensors, f32 } from '../src/model/safetensors';
 import { MM_PER_UNIT, loadTemplate } from '../src/template/face-template';
-import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
+import { ReferenceDecoder, decoderWeights, vertexTokens } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { fmaModule } from '../src/attention/simd-kernel';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
@@ -44,6 +44,13 @@ async function main() {
     // A second call reuses the buffers: same answer.
     const again = await dec.decode(tokens, poseTok, frames);
     result.gpuRepeatable = maxAbsDiff(again.offsets, g.offsets) === 0;
+    // From the hierarchical latents, the vertex tokens made on the GPU: against the reference decoder on the
+    // reference's tokens of the same latents
+    const latents = f32(fx, 'hierarchical_latents').subarray(0, frames * 2 * m.d_model);
+    const fromLatents = await dec.decodeLatents(latents, poseTok, frames);
+    const cpuFromLatents = new ReferenceDecoder(weights, template.adjacency, m).decode(vertexTokens(weights, latents, frames, m.d_model), poseTok, frames);
+    result.gpuLatentsVsCpuOffsets = maxAbsDiff(fromLatents.offsets, cpuFromLatents.offsets);
+    result.gpuLatentsVsCpuPose = maxAbsDiff(fromLatents.pose, cpuFromLatents.pose);
     dec.destroy();
   }
   result.simdFusedMultiplyAdd = fmaModule() !== null; // the SIMD decoder's matrix products and GELU fused (relaxed SIMD)

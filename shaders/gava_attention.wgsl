@@ -24,11 +24,11 @@ struct Params {
 
 @group(0) @binding(0) var<storage, read_write> x: array<f32>;        // (frames, t, D) residual stream
 @group(0) @binding(1) var<storage, read_write> qkv: array<f32>;      // (frames, t, 3D)
-@group(0) @binding(2) var<storage, read_write> attn: array<f32>;     // (frames, t, D) attention output
+@group(0) @binding(2) var<storage, read_write> attn: array<f32>;     // (frames, t, D) attention output; first the latents
 @group(0) @binding(3) var<uniform> params: Params;
 @group(0) @binding(4) var<storage, read> csr_offsets: array<u32>;    // (n + 1) 1-ring row starts
 @group(0) @binding(5) var<storage, read> csr_indices: array<u32>;    // 1-ring neighbours (no self)
-@group(0) @binding(6) var<storage, read> weights: array<f32>;        // all layers, then the heads
+@group(0) @binding(6) var<storage, read> weights: array<f32>;        // all layers, the heads, then the vertex tokens' e and W
 @group(0) @binding(7) var<storage, read_write> result: array<f32>;   // (frames, n, 3) offsets, then (frames, 6) pose
 
 var<workgroup> red: array<f32, MAX_D>;
@@ -83,6 +83,26 @@ fn erf(v: f32) -> f32 {
 }
 
 fn gelu(v: f32) -> f32 { return 0.5 * v * (1.0 + erf(v * 0.70710678118654752)); }
+
+// The vertex tokens of the hierarchical latents, before the first layer: attn holds each frame's [a, g] (2D numbers,
+// from hierarchical.onnx), and vertex j's token is local_out(gelu(a + e_j)) + g (reference.ts vertexTokens). The
+// weights after the heads' (11 D + 9 numbers) are e (n, D), local_out's W (D, D) and b (D). The pose token's row of
+// x is the one the CPU wrote.
+@compute @workgroup_size(D)
+fn vertex_tokens(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+  let i = lid.x;
+  let j = wid.x;
+  let frame = wid.y;
+  if (j >= params.n) { return; }
+  let e = params.final_base + 11u * D + 9u;
+  let w = e + params.n * D;
+  let latents = frame * 2u * D;
+  hbuf[i] = gelu(attn[latents + i] + weights[e + j * D + i]);
+  workgroupBarrier();
+  var acc = weights[w + D * D + i];
+  for (var k = 0u; k < D; k = k + 1u) { acc = acc + weights[w + i * D + k] * hbuf[k]; }
+  x[(frame * params.t + j) * D + i] = acc + attn[latents + D + i];
+}
 
 @compute @workgroup_size(D)
 fn ln_qkv(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {

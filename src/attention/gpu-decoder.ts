@@ -25,6 +25,7 @@ export function packWeights(w: DecoderWeights): { data: Float32Array; layerBases
   }
   const finalBase = size;
   for (const a of [w.lnG, w.lnB, w.dispW, w.dispB, w.poseW, w.poseB]) push(a);
+  for (const a of [w.vertexEmbedding, w.localOutW, w.localOutB]) push(a); // the shader's vertex_tokens: at final_base + 11 d + 9
   const data = new Float32Array(size);
   let o = 0;
   for (const a of parts) {
@@ -35,9 +36,12 @@ export function packWeights(w: DecoderWeights): { data: Float32Array; layerBases
 }
 
 export class GpuDecoder {
-  private readonly pipelines: Record<'ln_qkv' | 'attend' | 'out_ffn' | 'heads', GPUComputePipeline>;
+  private readonly pipelines: Record<'vertex_tokens' | 'ln_qkv' | 'attend' | 'out_ffn' | 'heads', GPUComputePipeline>;
   private readonly bindGroups: GPUBindGroup[]; // one per layer, then one for the heads
   private readonly x: GPUBuffer;
+  private readonly attn: GPUBuffer;
+  /** Whether the weights' vertex embedding is this mesh's (decodeLatents needs it; decode does not). */
+  private readonly makesTokens: boolean;
   private readonly result: GPUBuffer;
   private readonly readback: GPUBuffer;
   private readonly uniforms: GPUBuffer[];
@@ -73,7 +77,8 @@ export class GpuDecoder {
     const frameTokens = maxFrames * this.t;
     this.x = storage('GpuDecoder.x', frameTokens * d * 4);
     const qkv = storage('GpuDecoder.qkv', frameTokens * 3 * d * 4);
-    const attn = storage('GpuDecoder.attn', frameTokens * d * 4);
+    const attn = (this.attn = storage('GpuDecoder.attn', frameTokens * d * 4));
+    this.makesTokens = weights.vertexEmbedding.length === this.n * d;
     const offsets = upload('GpuDecoder.csrOffsets', adjacency.offsets);
     const indices = upload('GpuDecoder.csrIndices', adjacency.indices.length ? adjacency.indices : new Uint32Array(1));
     const packed = packWeights(weights);
@@ -101,7 +106,10 @@ export class GpuDecoder {
     const constants = { D: d, HEADS: m.heads, FFN: m.ffn, LN_EPS: weights.lnEps };
     const pipeline = (entryPoint: string) =>
       device.createComputePipeline({ label: `GpuDecoder.${entryPoint}`, layout: pipelineLayout, compute: { module, entryPoint, constants } });
-    this.pipelines = { ln_qkv: pipeline('ln_qkv'), attend: pipeline('attend'), out_ffn: pipeline('out_ffn'), heads: pipeline('heads') };
+    this.pipelines = {
+      vertex_tokens: pipeline('vertex_tokens'), ln_qkv: pipeline('ln_qkv'), attend: pipeline('attend'), out_ffn: pipeline('out_ffn'),
+      heads: pipeline('heads'),
+    };
 
     // One uniform buffer per layer (and one for the heads): all passes are encoded before the queue
     // runs them, so a single buffer rewritten between passes would hold only its last value.
@@ -126,22 +134,36 @@ export class GpuDecoder {
 
   /** tokens (F x N x d), poseToken (F x d) -> offsets (F x N x 3) mm, pose (F x 6). Calls are serialised. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
-    const run = this.busy.then(() => this.run(tokens, poseToken, frames));
+    return this.serialised(() => this.run(tokens, null, poseToken, frames));
+  }
+
+  /** latents (F x 2d: the hierarchical feature's [a, g]), poseToken (F x d) -> as decode; the vertex tokens are made on the GPU. */
+  decodeLatents(latents: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
+    return this.serialised(() => this.run(null, latents, poseToken, frames));
+  }
+
+  private serialised(job: () => Promise<DecodeResult>): Promise<DecodeResult> {
+    const run = this.busy.then(job);
     // Deliberate: the caller receives the run's error through `run`; `busy` only orders the runs.
     this.busy = run.catch(() => undefined); // the caller gets the error through `run`; `busy` only orders runs
     return run;
   }
 
-  private async run(tokens: Float32Array, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
+  /** One batch, from vertex tokens or (tokens null) from latents. */
+  private async run(tokens: Float32Array | null, latents: Float32Array | null, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
     const { device, n, t, d } = this;
     if (frames > this.maxFrames) throw new RangeError(`GpuDecoder: ${frames} frames exceed the ${this.maxFrames} it was built for`);
-    if (tokens.length !== frames * n * d || poseToken.length !== frames * d) throw new RangeError('GpuDecoder: token arrays do not match the frame count');
+    if ((tokens && tokens.length !== frames * n * d) || (latents && latents.length !== frames * 2 * d) || poseToken.length !== frames * d) {
+      throw new RangeError('GpuDecoder: token arrays do not match the frame count');
+    }
+    if (latents && !this.makesTokens) throw new Error(`GpuDecoder: the vertex embedding is not of this mesh's ${n} vertices`);
     const xs = new Float32Array(frames * t * d);
     for (let f = 0; f < frames; f++) {
-      xs.set(tokens.subarray(f * n * d, (f + 1) * n * d), f * t * d);
+      if (tokens) xs.set(tokens.subarray(f * n * d, (f + 1) * n * d), f * t * d);
       xs.set(poseToken.subarray(f * d, (f + 1) * d), (f * t + n) * d);
     }
     device.queue.writeBuffer(this.x, 0, xs);
+    if (latents) device.queue.writeBuffer(this.attn, 0, latents.buffer, latents.byteOffset, latents.byteLength);
     const params = new ArrayBuffer(PARAMS_BYTES);
     const u32 = new Uint32Array(params);
     const f32 = new Float32Array(params);
@@ -154,6 +176,11 @@ export class GpuDecoder {
     const encoder = device.createCommandEncoder({ label: 'GpuDecoder.encoder' });
     const pass = encoder.beginComputePass({ label: 'GpuDecoder.pass' });
     const layers = this.uniforms.length - 1;
+    if (latents) { // the heads' uniforms hold final_base, where the vertex tokens' weights begin
+      pass.setBindGroup(0, this.bindGroups[layers]);
+      pass.setPipeline(this.pipelines.vertex_tokens);
+      pass.dispatchWorkgroups(n, frames);
+    }
     for (let l = 0; l < layers; l++) {
       pass.setBindGroup(0, this.bindGroups[l]);
       for (const p of ['ln_qkv', 'attend', 'out_ffn'] as const) {

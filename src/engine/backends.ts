@@ -126,8 +126,7 @@ export class DecoderBackends {
     const d = this.m.d_model;
     for (let i = 0; i < frames; i += step) {
       const j = Math.min(frames, i + step);
-      const tokens = this.cpu.vertexTokens(latents.subarray(i * 2 * d, j * 2 * d), j - i);
-      const r = await gpu.decode(tokens, poseToken.subarray(i * d, j * d), j - i);
+      const r = await gpu.decodeLatents(latents.subarray(i * 2 * d, j * 2 * d), poseToken.subarray(i * d, j * d), j - i);
       out.offsets.set(r.offsets, i * n * 3);
       out.pose.set(r.pose, i * 6);
     }

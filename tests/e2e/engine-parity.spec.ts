@@ -12,6 +12,8 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder (WebAssembly SIMD a
   expect((r.adapter as { architecture: string }).architecture).toBe('swiftshader');
   expect(r.gpuVsCpuOffsets as number).toBeLessThan(1e-4);
   expect(r.gpuVsCpuPose as number).toBeLessThan(1e-5);
+  expect(r.gpuLatentsVsCpuOffsets as number, 'the vertex tokens made on the GPU').toBeLessThan(1e-5);
+  expect(r.gpuLatentsVsCpuPose as number, 'the vertex tokens made on the GPU').toBeLessThan(1e-5);
   expect(r.gpuVsTorchOffsets as number).toBeLessThan(1e-4);
   expect(r.simdFusedMultiplyAdd, 'Chromium has relaxed SIMD: the SIMD decoder below fuses its matrix products and GELU').toBe(true);
   for (const kernel of ['wasm-simd', 'js']) {
