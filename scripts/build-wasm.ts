@@ -13,7 +13,7 @@ import { fileURLToPath } from 'node:url';
 import wabtInit from 'wabt';
 
 /**
- * A kernel: a .wat assembled as it is, or (`fma`) that file's matrix product and GELU alone, each `acc + a * b` of theirs
+ * A kernel: a .wat assembled as it is, or (`fma`) that file's FUSED_EXPORTS alone, each `acc + a * b` of theirs
  * fused into one multiply-add (fmaKernels).
  */
 export interface Kernel {
@@ -23,7 +23,7 @@ export interface Kernel {
 }
 
 /** The exported functions of decoder.wat that the fused module holds (with the functions they call). */
-export const FUSED_EXPORTS = ['matmul', 'gelu'];
+export const FUSED_EXPORTS = ['matmul', 'gelu', 'attention_d32h4'];
 
 export const KERNELS: Kernel[] = [
   { wat: 'src/attention/simd/decoder.wat', out: 'src/attention/simd/decoder-wasm.ts' },

@@ -35,8 +35,9 @@ export function simdModule(): WebAssembly.Module | null {
 let fused: WebAssembly.Module | null | undefined;
 
 /**
- * The matrix product and GELU with fused multiply-adds (relaxed SIMD's f32x4.relaxed_madd; simd/decoder-fma-wasm.ts,
- * made by `npm run build:wasm` from decoder.wat's matmul and gelu), or null where this runtime lacks relaxed SIMD (not
+ * The matrix product, GELU and the d 32 / 4 heads attention with fused multiply-adds (relaxed SIMD's
+ * f32x4.relaxed_madd; simd/decoder-fma-wasm.ts, made by `npm run build:wasm` from decoder.wat's matmul, gelu and
+ * attention_d32h4), or null where this runtime lacks relaxed SIMD (not
  * every browser has it; Node without --experimental-wasm-relaxed-simd), where the plain ones run. One rounding fewer
  * per multiply-add where the CPU has FMA, and faster (docs/results/README.md, Speed); on a CPU without FMA the same
  * numbers as the plain ones.
@@ -76,8 +77,8 @@ export class SimdKernel implements DecoderKernel {
   /** Whether the matrix products and GELU fuse their multiply-adds (fmaModule). */
   readonly fusedMultiplyAdd: boolean;
   private readonly exports: SimdExports;
-  /** matmul and gelu: the fused module's where there is one, else the plain module's. */
-  private readonly fusable: Pick<SimdExports, 'matmul' | 'gelu'>;
+  /** matmul, gelu and attention_d32h4: the fused module's where there is one, else the plain module's. */
+  private readonly fusable: Pick<SimdExports, 'matmul' | 'gelu' | 'attention_d32h4'>;
   private used = 0;
   private readonly capacity: number;
   private readonly geluValue: Float64Array;
@@ -171,7 +172,7 @@ export class SimdKernel implements DecoderKernel {
     this.mine(qkv, keyStart, keyIndex, scores, out);
     if (d === 32 && heads === 4) {
       // The model's shape: all four heads of a key at once (decoder.wat, attention_d32h4).
-      this.exports.attention_d32h4(qkv.byteOffset, tokens, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset, out.byteOffset, 1 / Math.sqrt(8));
+      this.fusable.attention_d32h4(qkv.byteOffset, tokens, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset, out.byteOffset, 1 / Math.sqrt(8));
       return;
     }
     this.exports.attention(qkv.byteOffset, tokens, d, heads, keyStart.byteOffset, keyIndex.byteOffset, scores.byteOffset,
