@@ -9,14 +9,19 @@ import { loadDecoderWeights, loadFixtures, loadManifest, loadTemplateFile, maxAb
 const manifest = loadManifest();
 const fx = loadFixtures(manifest);
 
+/** The exported model's decoder on `kernel`, with what the tests feed it. */
+async function exportedDecoder(kernel: 'js' | 'wasm-simd') {
+  const m = manifest.model.config;
+  const template = await loadTemplateFile(manifest);
+  const weights = loadDecoderWeights(manifest);
+  const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
+  return { m, template, weights, decoder, frames: manifest.fixtures.token_frames, poseTok: f32(fx, 'pose_token') };
+}
+
 describe('the fast decoder vs the PyTorch fixture', () => {
   it.each(['js', 'wasm-simd'] as const)('the fast CPU decoder (%s arithmetic) matches PyTorch and the reference decoder', async (kernel) => {
-    const m = manifest.model.config;
-    const template = await loadTemplateFile(manifest);
-    const weights = loadDecoderWeights(manifest);
-    const frames = manifest.fixtures.token_frames;
-    const tokens = f32(fx, 'tokens'), poseTok = f32(fx, 'pose_token');
-    const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
+    const { m, template, weights, decoder, frames, poseTok } = await exportedDecoder(kernel);
+    const tokens = f32(fx, 'tokens');
     expect(decoder.kernelName).toBe(kernel);
     const fast = decoder.decode(tokens, poseTok, frames);
     const ref = new ReferenceDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames);
@@ -29,12 +34,8 @@ describe('the fast decoder vs the PyTorch fixture', () => {
   });
 
   it.each(['js', 'wasm-simd'] as const)('the fast decoder (%s) makes the vertex tokens of the hierarchical latents as PyTorch and the reference do', async (kernel) => {
-    const m = manifest.model.config;
-    const template = await loadTemplateFile(manifest);
-    const weights = loadDecoderWeights(manifest);
-    const frames = manifest.fixtures.token_frames;
-    const latents = f32(fx, 'hierarchical_latents'), poseTok = f32(fx, 'pose_token');
-    const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
+    const { m, template, weights, decoder, frames, poseTok } = await exportedDecoder(kernel);
+    const latents = f32(fx, 'hierarchical_latents');
     const tokens = decoder.vertexTokens(latents, frames);
     const scale = f32(fx, 'tokens').reduce((s, v) => Math.max(s, Math.abs(v)), 0);
     expect(scale).toBeGreaterThan(0.1);
