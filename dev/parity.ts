@@ -53,7 +53,7 @@ async function main() {
     result.gpuLatentsVsCpuPose = maxAbsDiff(fromLatents.pose, cpuFromLatents.pose);
     dec.destroy();
   }
-  result.simdFusedMultiplyAdd = fmaModule() !== null; // the SIMD decoder's matrix products and GELU fused (relaxed SIMD)
+  result.simdFusedMultiplyAdd = fmaModule() !== null; // the SIMD decoder's matrix products, GELU and attention fused (relaxed SIMD)
   for (const kernel of ['wasm-simd', 'js'] as const) {
     const decoder = new FastDecoder(weights, template.adjacency, m, kernel);
     const fast = decoder.decode(tokens, poseTok, frames);

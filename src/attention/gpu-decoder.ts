@@ -1,7 +1,8 @@
 /**
  * The GAVA decoder as WGSL compute passes (shaders/gava_attention.wgsl), batched over frames.
  * Same interface and numbers as ReferenceDecoder (src/attention/reference.ts), which is what the
- * browser tests compare it with. Per layer: ln_qkv -> attend -> out_ffn; then heads.
+ * browser tests compare it with. From latents (decodeLatents), first vertex_tokens; per layer: ln_qkv -> attend ->
+ * out_ffn; then heads.
  */
 import shaderSource from '../../shaders/gava_attention.wgsl?raw';
 import type { ModelConstants } from '../model/manifest';

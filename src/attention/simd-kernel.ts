@@ -70,11 +70,12 @@ interface SimdExports {
 
 /**
  * The SIMD kernel over one memory of `bytes` bytes (everything alloc'd, placed and packed, plus alignment); its matrix
- * products and GELU with fused multiply-adds where the runtime has relaxed SIMD, unless `fma` is false.
+ * products, GELU and the model's attention with fused multiply-adds where the runtime has relaxed SIMD, unless `fma`
+ * is false.
  */
 export class SimdKernel implements DecoderKernel {
   readonly name = 'wasm-simd';
-  /** Whether the matrix products and GELU fuse their multiply-adds (fmaModule). */
+  /** Whether the matrix products, GELU and the model's attention fuse their multiply-adds (fmaModule). */
   readonly fusedMultiplyAdd: boolean;
   private readonly exports: SimdExports;
   /** matmul, gelu and attention_d32h4: the fused module's where there is one, else the plain module's. */

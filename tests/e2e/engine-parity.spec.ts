@@ -15,7 +15,7 @@ test('WGSL decoder = TypeScript reference = fast CPU decoder (WebAssembly SIMD a
   expect(r.gpuLatentsVsCpuOffsets as number, 'the vertex tokens made on the GPU').toBeLessThan(1e-5);
   expect(r.gpuLatentsVsCpuPose as number, 'the vertex tokens made on the GPU').toBeLessThan(1e-5);
   expect(r.gpuVsTorchOffsets as number).toBeLessThan(1e-4);
-  expect(r.simdFusedMultiplyAdd, 'Chromium has relaxed SIMD: the SIMD decoder below fuses its matrix products and GELU').toBe(true);
+  expect(r.simdFusedMultiplyAdd, 'Chromium has relaxed SIMD: the SIMD decoder below fuses its matrix products, GELU and attention').toBe(true);
   for (const kernel of ['wasm-simd', 'js']) {
     expect(r[`fast_${kernel}_VsCpuOffsets`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-4);
     expect(r[`fast_${kernel}_VsCpuPose`] as number, `fast decoder, ${kernel}`).toBeLessThan(1e-5);

@@ -314,7 +314,8 @@
   ;; of a key together, so a key's row is found once, not once per head, and its four scores are one vector
   ;; (lane h: head h). The softmax then goes four heads at a time and the weighted sum of the values stays in
   ;; registers. The same operations as attention above, in the same order, but for the softmax's denominator
-  ;; (summed key after key here, four keys to a lane there). `scores`: 16 bytes per key of the longest list,
+  ;; (summed key after key here, four keys to a lane there); in the fused module (decoder-fma-wasm.ts) each
+  ;; multiply-add is one rounding, so its sums differ in the last bits. `scores`: 16 bytes per key of the longest list,
   ;; 16-byte aligned. qkv rows are 384 bytes: the query at 0, the key at 128, the value at 256; out rows 128 bytes.
   (func (export "attention_d32h4")
     (param $qkv i32) (param $tokens i32) (param $key_start i32) (param $key_index i32) (param $scores i32)
@@ -356,7 +357,7 @@
                                       (f32x4.mul (local.get $q5) (v128.load offset=208 (local.get $kp)))))
             (local.set $a3 (f32x4.add (f32x4.mul (local.get $q6) (v128.load offset=224 (local.get $kp)))
                                       (f32x4.mul (local.get $q7) (v128.load offset=240 (local.get $kp)))))
-            ;; lane h of the result: the sum of a_h's four lanes, (0 + 1) + (2 + 3) as attention sums them
+            ;; lane h of the result: the sum of a_h's four lanes, (0 + 1) + (2 + 3) as attention sums them (plain module)
             (local.set $a0 (f32x4.add (i8x16.shuffle 0 1 2 3 16 17 18 19 8 9 10 11 24 25 26 27 (local.get $a0) (local.get $a1))
                                       (i8x16.shuffle 4 5 6 7 20 21 22 23 12 13 14 15 28 29 30 31 (local.get $a0) (local.get $a1))))
             (local.set $a2 (f32x4.add (i8x16.shuffle 0 1 2 3 16 17 18 19 8 9 10 11 24 25 26 27 (local.get $a2) (local.get $a3))

@@ -54,8 +54,9 @@ describe('the SIMD kernel', () => {
     expect(maxAbsDiff(sx, x)).toBe(0);
   });
 
-  it('the SIMD attention equals the TypeScript attention on ragged key lists, large and small scores', () => {
-    const simd = new SimdKernel(1 << 20);
+  it.each([true, false])('the SIMD attention (fused multiply-adds: %s) equals the TypeScript attention on ragged key lists, large and small scores', (fma) => {
+    const simd = new SimdKernel(1 << 20, fma);
+    expect(simd.fusedMultiplyAdd).toBe(fma);
     // d 32 in 4 heads: the model's shape, which runs attention_d32h4 (all heads of a key at once); the others the general attention.
     for (const [d, heads, amp] of [[32, 4, 1], [32, 4, 40], [16, 1, 1], [32, 2, 40]]) {
       const tokens = 9;
@@ -70,7 +71,7 @@ describe('the SIMD kernel', () => {
     }
   });
 
-  it('fuses its matrix products and GELU where relaxed SIMD is there (vitest runs Node with it), and they equal the plain ones', () => {
+  it('fuses its matrix products, GELU and attention where relaxed SIMD is there (vitest runs Node with it), and they equal the plain ones', () => {
     const fused = new SimdKernel(1 << 20);
     const plain = new SimdKernel(1 << 20, false);
     expect([fused.fusedMultiplyAdd, plain.fusedMultiplyAdd]).toEqual([true, false]);
@@ -91,6 +92,18 @@ describe('the SIMD kernel', () => {
     });
     expect(maxAbsDiff(a, c)).toBeLessThan(1e-6);
     expect(maxAbsDiff(a, c)).toBeGreaterThan(0); // the fused GELU is not the plain one
+    // and the model's attention (attention_d32h4): fused, not the plain one, and as near
+    const tokens = 5, d = 32;
+    const keyStart = Int32Array.from([0, 2, 4, 7, 9, 14]);
+    const keys = Int32Array.from([0, 1, 1, 2, 2, 3, 0, 3, 4, 4, 0, 1, 2, 3]);
+    const qkv = Float32Array.from({ length: tokens * 3 * d }, (_, i) => 3 * Math.sin(i * 0.37));
+    const [p, q] = [fused, plain].map((k) => {
+      const out = k.alloc(tokens * d);
+      k.attention(k.place(qkv), tokens, d, 4, k.placeInts(keyStart), k.placeInts(keys), k.scratch(tokens), out);
+      return out;
+    });
+    expect(maxAbsDiff(p, q)).toBeLessThan(1e-5);
+    expect(maxAbsDiff(p, q)).toBeGreaterThan(0);
   });
 
   it('the embedded WebAssembly is what the committed .wat assembles to (npm run build:wasm)', async () => {
