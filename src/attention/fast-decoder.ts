@@ -14,7 +14,7 @@
  */
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
-import { keyLists, type DecodeResult, type DecoderWeights } from './reference';
+import { keyLists, vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from './reference';
 import { geluInPlace, jsKernel, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
 import { simdModule, SimdKernel } from './simd-kernel';
 
@@ -38,6 +38,8 @@ export class FastDecoder {
   private readonly kernel: DecoderKernel;
   private readonly layers: PackedLayer[];
   private readonly vertexEmbedding: Float32Array | null;
+  /** Why decodeLatents cannot run (weights of another mesh), or null. */
+  private readonly noTokens: string | null;
   private readonly localOut: PackedWeight;
   private readonly lnG: Float32Array;
   private readonly lnB: Float32Array;
@@ -92,7 +94,8 @@ export class FastDecoder {
       ffn2: k.pack(L.ffn2W, L.ffn2B, d, m.ffn),
     }));
     // Weights of another mesh decode tokens given (decode) but cannot make them (decodeLatents): the benchmark's larger meshes.
-    this.vertexEmbedding = weights.vertexEmbedding.length === n * d ? k.place(weights.vertexEmbedding) : null;
+    this.noTokens = vertexEmbeddingMismatch(weights, n, d);
+    this.vertexEmbedding = this.noTokens ? null : k.place(weights.vertexEmbedding);
     // Its bias is rewritten every frame with localOutB + g (a copy: the TypeScript kernel packs the arrays it is given).
     this.localOut = k.pack(weights.localOutW, weights.localOutB.slice(), d, d);
     this.lnG = k.place(weights.lnG);
@@ -105,15 +108,7 @@ export class FastDecoder {
   /** tokens (F x N x d), poseToken (F x d) -> displacement (F x N x 3, mm) and pose (F x 6) per frame. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number): DecodeResult {
     const { n, d } = this;
-    const offsets = new Float32Array(frames * n * 3);
-    const pose = new Float32Array(frames * 6);
-    for (let f = 0; f < frames; f++) {
-      this.x.set(tokens.subarray(f * n * d, (f + 1) * n * d), 0);
-      this.x.set(poseToken.subarray(f * d, (f + 1) * d), n * d);
-      for (const L of this.layers) this.layer(L);
-      this.heads(offsets, pose, f);
-    }
-    return { offsets, pose };
+    return this.frames(poseToken, frames, (f) => this.x.set(tokens.subarray(f * n * d, (f + 1) * n * d), 0));
   }
 
   /**
@@ -121,11 +116,16 @@ export class FastDecoder {
    * tokens are made here, in the decoder's arithmetic: localOut(gelu(a + e_j)) + g (reference.ts vertexTokens).
    */
   decodeLatents(latents: Float32Array, poseToken: Float32Array, frames: number): DecodeResult {
+    return this.frames(poseToken, frames, (f) => this.vertexTokensOf(latents, f));
+  }
+
+  /** Every frame: `vertexRows(f)` fills x's N vertex rows, then the pose token, the layers and the heads. */
+  private frames(poseToken: Float32Array, frames: number, vertexRows: (f: number) => void): DecodeResult {
     const { n, d } = this;
     const offsets = new Float32Array(frames * n * 3);
     const pose = new Float32Array(frames * 6);
     for (let f = 0; f < frames; f++) {
-      this.vertexTokensOf(latents, f);
+      vertexRows(f);
       this.x.set(poseToken.subarray(f * d, (f + 1) * d), n * d);
       for (const L of this.layers) this.layer(L);
       this.heads(offsets, pose, f);
@@ -147,7 +147,7 @@ export class FastDecoder {
   /** Frame f's vertex tokens into x's first N rows (h is scratch): g rides in the product's bias. */
   private vertexTokensOf(latents: Float32Array, f: number): void {
     const { n, d, h, x, rows, vertexEmbedding: e, kernel: k } = this;
-    if (!e) throw new Error(`FastDecoder: the vertex embedding has ${this.weights.vertexEmbedding.length / d} vertices, the template ${n}`);
+    if (!e) throw new Error(`FastDecoder: ${this.noTokens}`);
     const a = f * 2 * d, g = a + d;
     for (let j = 0; j < n; j++) {
       const r = j * d;

@@ -7,7 +7,7 @@
 import shaderSource from '../../shaders/gava_attention.wgsl?raw';
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
-import type { DecodeResult, DecoderWeights } from './reference';
+import { vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from './reference';
 
 const PARAMS_BYTES = 32; // struct Params in the shader: 5 x u32, 2 x f32, padding
 
@@ -41,8 +41,8 @@ export class GpuDecoder {
   private readonly bindGroups: GPUBindGroup[]; // one per layer, then one for the heads
   private readonly x: GPUBuffer;
   private readonly attn: GPUBuffer;
-  /** Whether the weights' vertex embedding is this mesh's (decodeLatents needs it; decode does not). */
-  private readonly makesTokens: boolean;
+  /** Why decodeLatents cannot run (weights of another mesh; decode can), or null. */
+  private readonly noTokens: string | null;
   private readonly result: GPUBuffer;
   private readonly readback: GPUBuffer;
   private readonly uniforms: GPUBuffer[];
@@ -79,7 +79,7 @@ export class GpuDecoder {
     this.x = storage('GpuDecoder.x', frameTokens * d * 4);
     const qkv = storage('GpuDecoder.qkv', frameTokens * 3 * d * 4);
     const attn = (this.attn = storage('GpuDecoder.attn', frameTokens * d * 4));
-    this.makesTokens = weights.vertexEmbedding.length === this.n * d;
+    this.noTokens = vertexEmbeddingMismatch(weights, this.n, d);
     const offsets = upload('GpuDecoder.csrOffsets', adjacency.offsets);
     const indices = upload('GpuDecoder.csrIndices', adjacency.indices.length ? adjacency.indices : new Uint32Array(1));
     const packed = packWeights(weights);
@@ -145,7 +145,6 @@ export class GpuDecoder {
 
   private serialised(job: () => Promise<DecodeResult>): Promise<DecodeResult> {
     const run = this.busy.then(job);
-    // Deliberate: the caller receives the run's error through `run`; `busy` only orders the runs.
     this.busy = run.catch(() => undefined); // the caller gets the error through `run`; `busy` only orders runs
     return run;
   }
@@ -157,7 +156,7 @@ export class GpuDecoder {
     if ((tokens && tokens.length !== frames * n * d) || (latents && latents.length !== frames * 2 * d) || poseToken.length !== frames * d) {
       throw new RangeError('GpuDecoder: token arrays do not match the frame count');
     }
-    if (latents && !this.makesTokens) throw new Error(`GpuDecoder: the vertex embedding is not of this mesh's ${n} vertices`);
+    if (latents && this.noTokens) throw new Error(`GpuDecoder: ${this.noTokens}`);
     const xs = new Float32Array(frames * t * d);
     for (let f = 0; f < frames; f++) {
       if (tokens) xs.set(tokens.subarray(f * n * d, (f + 1) * n * d), f * t * d);

@@ -62,6 +62,12 @@ export function decoderWeights(t: Map<string, Tensor>, m: ModelConstants, eps: n
   };
 }
 
+/** Why weights cannot make the vertex tokens of an N-vertex mesh (their vertex embedding is another mesh's), or null. */
+export function vertexEmbeddingMismatch(w: DecoderWeights, n: number, d: number): string | null {
+  const have = w.vertexEmbedding.length / d;
+  return have === n ? null : `the decoder weights' vertex embedding has ${have} vertices, the template ${n}: they are of different meshes`;
+}
+
 /**
  * The vertex tokens (F x N x d) of frames' hierarchical latents (F x 2d: [a, g], hierarchical.onnx's output):
  * token j = localOut(gelu(a + e_j)) + g, exact GELU. The readable form FastDecoder.decodeLatents is held to.

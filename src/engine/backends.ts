@@ -6,7 +6,7 @@
 import { FastDecoder } from '../attention/fast-decoder';
 import { DecoderPool } from '../attention/decoder-pool';
 import { GpuDecoder } from '../attention/gpu-decoder';
-import type { DecodeResult, DecoderWeights } from '../attention/reference';
+import { vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from '../attention/reference';
 import { detectWebGPU, requestSharedDevice, type WebGPUSupport } from '../gpu/capabilities';
 import { ModelLoadError } from '../model/artefacts';
 import type { ModelConstants } from '../model/manifest';
@@ -42,11 +42,8 @@ export class DecoderBackends {
 
   static async create(weights: DecoderWeights, adjacency: Adjacency, m: ModelConstants, support: WebGPUSupport, gpuFrames: number,
     options: BackendOptions = {}): Promise<DecoderBackends> {
-    const n = adjacency.offsets.length - 1;
-    if (weights.vertexEmbedding.length !== n * m.d_model) {
-      throw new ModelLoadError(`the model's vertex embedding has ${weights.vertexEmbedding.length / m.d_model} vertices, its template ${n}: `
-        + 'the decoder weights and the template are of different meshes');
-    }
+    const mismatch = vertexEmbeddingMismatch(weights, adjacency.offsets.length - 1, m.d_model);
+    if (mismatch) throw new ModelLoadError(mismatch);
     const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';

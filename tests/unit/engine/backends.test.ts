@@ -16,7 +16,7 @@ describe('DecoderBackends.create', () => {
     const n = template.adjacency.offsets.length - 1;
     const refused = DecoderBackends.create(other, template.adjacency, m, noGpu, 8, { cpuWorkers: 1 });
     await expect(refused).rejects.toThrow(ModelLoadError);
-    await expect(refused).rejects.toThrow(`has 10 vertices, its template ${n}`);
+    await expect(refused).rejects.toThrow(`has 10 vertices, the template ${n}`);
     const backends = await DecoderBackends.create(weights, template.adjacency, m, noGpu, 8, { cpuWorkers: 1 });
     expect(backends.backend).toBe('cpu');
   });

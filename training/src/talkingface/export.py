@@ -45,22 +45,16 @@ OPSET = 17
 
 
 class _HierarchicalLatents(nn.Module):
-    """The part of the hierarchical feature that is one per frame, [a, g] (F, 2d): a = local_in(window), g = the
-    global MLP (zeros for a part the model lacks). The per-vertex part, local_out(gelu(a + e_j)) + g, is N times the
-    work and N times the bytes; the browser's decoder computes it (vertex_token_tensors), so only 2d numbers a frame
-    leave onnxruntime."""
+    """hierarchical.onnx: the part of the hierarchical feature that is one per frame, [a, g] (F, 2d)
+    (HierarchicalFeature.latents). The per-vertex part, local_out(gelu(a + e_j)) + g, is N times the work and N times
+    the bytes; the browser's decoder computes it (vertex_token_tensors), so only 2d numbers a frame leave onnxruntime."""
 
     def __init__(self, model):
         super().__init__()
         self.h = model.hierarchical
-        self.d = model.cfg.d_model
 
     def forward(self, window):
-        flat = window.flatten(1)
-        zeros = flat.new_zeros(flat.shape[0], self.d)
-        a = self.h.local_in(flat) if self.h.use_local else zeros
-        g = self.h.global_mlp(flat) if self.h.use_global else zeros
-        return torch.cat([a, g], 1)
+        return self.h.latents(window)
 
 
 def vertex_token_tensors(model, template_mm: torch.Tensor) -> dict[str, np.ndarray]:
@@ -69,9 +63,7 @@ def vertex_token_tensors(model, template_mm: torch.Tensor) -> dict[str, np.ndarr
     without the local part gets zeros, so that its tokens are g alone, as the model's."""
     h, d, n = model.hierarchical, model.cfg.d_model, model.num_vertices
     if h.use_local:
-        e = h.vertex_embedding.detach()
-        if h.shape_in is not None:
-            e = e + h.shape_in(model.template_delta(template_mm))[0].detach()
+        e = h.vertex_embeddings(model.template_delta(template_mm) if h.shape_in is not None else None)[0].detach()
         w, b = h.local_out.weight.detach(), h.local_out.bias.detach()
     else:
         e, w, b = torch.zeros(n, d), torch.zeros(d, d), torch.zeros(d)

@@ -19,11 +19,6 @@ FIXTURE_SECONDS = 0.6     # a short clip keeps the fixtures small
 FIXTURE_TOKEN_FRAMES = 2  # frames whose tokens and per-layer outputs are kept
 
 
-def _latents(model: TalkingFace, windows: torch.Tensor) -> torch.Tensor:
-    from .export import _HierarchicalLatents
-    return _HierarchicalLatents(model)(windows)
-
-
 @torch.no_grad()
 def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarray, out: Path, head_motion=None,
                    lip_closure=None) -> dict:
@@ -39,7 +34,7 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     mel_index = torch.from_numpy(frame_to_mel_index(np.arange(n_frames), a)).clamp(max=mel.shape[0] - 1)
     windows = model.content_windows(logits, mel_index[None])[0]                # (F, W, D)
     tokens = model.hierarchical(windows)                                       # (F, N, d)
-    latents = _latents(model, windows)                                         # (F, 2d): what hierarchical.onnx gives
+    latents = model.hierarchical.latents(windows)                                         # (F, 2d): what hierarchical.onnx gives
     conv = model.pose_encoder.conv(model.pose_encoder.norm(mel_t).transpose(1, 2)).transpose(1, 2)
     pose_feat, _ = model.pose_encoder(mel_t)                                   # (1, K, d)
     pose_token = pose_feat[0, mel_index]                                       # (F, d)

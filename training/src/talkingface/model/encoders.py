@@ -112,6 +112,7 @@ class HierarchicalFeature(nn.Module):
             nn.init.zeros_(self.shape_in.weight)
             nn.init.zeros_(self.shape_in.bias)
         self.num_vertices = num_vertices
+        self.d_model = d
 
     def forward(self, window: torch.Tensor, delta: torch.Tensor | None = None) -> torch.Tensor:
         """(B, W, D) posteriors -> (B, N, d) tokens. delta: (B or 1, N, 3) the neutral face minus the reference
@@ -120,14 +121,28 @@ class HierarchicalFeature(nn.Module):
         tokens = 0
         if self.use_local:
             a = self.local_in(flat)[:, None, :]                                # (B, 1, d)
-            e = self.vertex_embedding[None]                                    # (1, N, d)
-            if self.shape_in is not None:
-                e = e + (self.shape_in.bias if delta is None else self.shape_in(delta))
-            tokens = self.local_out(torch.nn.functional.gelu(a + e))           # (B, N, d)
+            tokens = self.local_out(torch.nn.functional.gelu(a + self.vertex_embeddings(delta)))  # (B, N, d)
         if self.use_global:
             g = self.global_mlp(flat)[:, None, :]                              # (B, 1, d)
             tokens = tokens + g if self.use_local else g.expand(-1, self.num_vertices, -1)
         return tokens
+
+    def vertex_embeddings(self, delta: torch.Tensor | None = None) -> torch.Tensor:
+        """e_j for a face, (1 or B, N, d): the vertex embedding, plus the shape term where the model has one."""
+        e = self.vertex_embedding[None]
+        if self.shape_in is not None:
+            e = e + (self.shape_in.bias if delta is None else self.shape_in(delta))
+        return e
+
+    def latents(self, window: torch.Tensor) -> torch.Tensor:
+        """The part of forward that is one per frame, (B, 2d): [a, g], a = local_in(window), g = the global MLP, zeros
+        for a part the model lacks; forward's tokens are local_out(gelu(a + e_j)) + g (the browser's decoder makes
+        them so: export.vertex_token_tensors)."""
+        flat = window.flatten(1)
+        zeros = flat.new_zeros(flat.shape[0], self.d_model)
+        a = self.local_in(flat) if self.use_local else zeros
+        g = self.global_mlp(flat) if self.use_global else zeros
+        return torch.cat([a, g], 1)
 
 
 class PoseEncoder(nn.Module):
