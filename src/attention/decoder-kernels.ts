@@ -36,6 +36,8 @@ export interface DecoderKernel {
   gelu(a: Float32Array, count: number): void;
   /** x[i] += y[i] for i < count */
   add(x: Float32Array, y: Float32Array, count: number): void;
+  /** out[r, i] = x[r, i] + row[i] for r < rows, i < d: `row` added to every row of x. */
+  addRow(x: Float32Array, row: Float32Array, rows: number, d: number, out: Float32Array): void;
 }
 
 /** out[t, o] = b[o] + sum_i W[o, i] X[t, i] for t < rows: W (outs x cols) row-major, X and out row-major. */
@@ -215,4 +217,13 @@ export const jsKernel: DecoderKernel = {
   add: (x, y, count) => {
     for (let i = 0; i < count; i++) x[i] += y[i];
   },
+  addRow: addRowTo,
 };
+
+/** out[r, i] = x[r, i] + row[i] for r < rows, i < d. */
+export function addRowTo(x: Float32Array, row: Float32Array, rows: number, d: number, out: Float32Array): void {
+  for (let r = 0; r < rows; r++) {
+    const o = r * d;
+    for (let i = 0; i < d; i++) out[o + i] = x[o + i] + row[i];
+  }
+}

@@ -41,6 +41,11 @@ export class FastDecoder {
   /** Why decodeLatents cannot run (weights of another mesh), or null. */
   private readonly noTokens: string | null;
   private readonly localOut: PackedWeight;
+  /** The frame's a, where the kernel reads it. */
+  private readonly aRow: Float32Array;
+  /** The displacement head, padded to 4 outputs (the SIMD product's width; the fourth is zeros), and its output. */
+  private readonly dispHead: PackedWeight;
+  private readonly dispOut: Float32Array;
   private readonly lnG: Float32Array;
   private readonly lnB: Float32Array;
   private readonly x: Float32Array;
@@ -73,8 +78,9 @@ export class FastDecoder {
     if (simd) {
       const L = weights.layers.length;
       const floats = rows * (6 * d + m.ffn) + L * (4 * d * d + 2 * d * m.ffn + 8 * d + m.ffn) + 2 * d
-        + n * d + d * d + d + lists.keyStart.length + lists.keys.length + SimdKernel.scratchFloats(n + 1);
-      const allocations = 11 + 14 * L;
+        + n * d + d * d + d + lists.keyStart.length + lists.keys.length + SimdKernel.scratchFloats(n + 1)
+        + d + 4 * d + 4 + 4 * rows;
+      const allocations = 15 + 14 * L;
       this.kernel = new SimdKernel(4 * floats + 16 * allocations);
     } else {
       this.kernel = jsKernel;
@@ -98,6 +104,12 @@ export class FastDecoder {
     this.vertexEmbedding = this.noTokens ? null : k.place(weights.vertexEmbedding);
     // Its bias is rewritten every frame with localOutB + g (a copy: the TypeScript kernel packs the arrays it is given).
     this.localOut = k.pack(weights.localOutW, weights.localOutB.slice(), d, d);
+    this.aRow = k.alloc(d);
+    const dispW = new Float32Array(4 * d), dispB = new Float32Array(4);
+    dispW.set(weights.dispW.subarray(0, 3 * d));
+    dispB.set(weights.dispB.subarray(0, 3));
+    this.dispHead = k.pack(dispW, dispB, 4, d);
+    this.dispOut = k.alloc(rows * 4);
     this.lnG = k.place(weights.lnG);
     this.lnB = k.place(weights.lnB);
     this.scores = k.scratch(n + 1);
@@ -149,10 +161,8 @@ export class FastDecoder {
     const { n, d, h, x, rows, vertexEmbedding: e, kernel: k } = this;
     if (!e) throw new Error(`FastDecoder: ${this.noTokens}`);
     const a = f * 2 * d, g = a + d;
-    for (let j = 0; j < n; j++) {
-      const r = j * d;
-      for (let i = 0; i < d; i++) h[r + i] = e[r + i] + latents[a + i];
-    }
+    this.aRow.set(latents.subarray(a, a + d));
+    k.addRow(e, this.aRow, n, d, h);
     h.fill(0, n * d, rows * d);
     k.gelu(h, n * d);
     const bias = this.localOut.b;
@@ -178,7 +188,13 @@ export class FastDecoder {
     const { n, d, x, h, raw } = this;
     const w = this.weights;
     this.kernel.layerNorm(x, this.tokens, d, this.lnG, this.lnB, h, this.weights.lnEps);
-    matmulRows(w.dispW, w.dispB, 3, d, h, n, offsets.subarray(f * n * 3, (f + 1) * n * 3));
+    const out = this.dispOut;
+    this.kernel.matmul(this.dispHead, h, this.rows, out);
+    for (let j = 0, o = f * n * 3; j < n; j++, o += 3) {
+      offsets[o] = out[4 * j];
+      offsets[o + 1] = out[4 * j + 1];
+      offsets[o + 2] = out[4 * j + 2];
+    }
     matmulRows(w.poseW, w.poseB, 6, d, h.subarray(n * d), 1, raw);
     for (let i = 0; i < 3; i++) pose[f * 6 + i] = this.m.max_rotation * Math.tanh(raw[i]);
     for (let i = 3; i < 6; i++) pose[f * 6 + i] = this.m.max_translation_mm * Math.tanh(raw[i]);

@@ -5,7 +5,7 @@
  */
 import { WASM_BASE64 } from './simd/decoder-wasm';
 import { WASM_BASE64 as FMA_BASE64 } from './simd/decoder-fma-wasm';
-import { GELU_RANGE, GELU_STEPS, geluTableData, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
+import { GELU_RANGE, GELU_STEPS, geluTableData, addRowTo, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
 
 let module: WebAssembly.Module | null | undefined;
 
@@ -66,6 +66,7 @@ interface SimdExports {
   attention_d32h4(qkv: number, tokens: number, keyStart: number, keyIndex: number, scores: number, out: number, scale: number): void;
   gelu(a: number, count: number, value: number, slope: number, range: number, steps: number): void;
   add(x: number, y: number, count: number): void;
+  add_row(x: number, row: number, rows: number, d: number, out: number): void;
 }
 
 /**
@@ -188,5 +189,14 @@ export class SimdKernel implements DecoderKernel {
   add(x: Float32Array, y: Float32Array, count: number): void {
     this.mine(x, y);
     this.exports.add(x.byteOffset, y.byteOffset, count);
+  }
+
+  addRow(x: Float32Array, row: Float32Array, rows: number, d: number, out: Float32Array): void {
+    if (d % 4) {
+      addRowTo(x, row, rows, d, out);
+      return;
+    }
+    this.mine(x, row, out);
+    this.exports.add_row(x.byteOffset, row.byteOffset, rows, d, out.byteOffset);
   }
 }

@@ -122,6 +122,26 @@
         (local.set $y (i32.add (local.get $y) (i32.const 4)))
         (br $one))))
 
+  ;; out[r, i] = x[r, i] + row[i] for r < rows, i < d: one row added to every row of x (d a multiple of 4)
+  (func (export "add_row") (param $x i32) (param $row i32) (param $rows i32) (param $d i32) (param $out i32)
+    (local $end i32) (local $bytes i32) (local $i i32)
+    (local.set $bytes (i32.shl (local.get $d) (i32.const 2)))
+    (local.set $end (i32.add (local.get $x) (i32.mul (local.get $rows) (local.get $bytes))))
+    (block $done
+      (loop $rows_loop
+        (br_if $done (i32.ge_u (local.get $x) (local.get $end)))
+        (local.set $i (i32.const 0))
+        (block $row_done
+          (loop $cols
+            (br_if $row_done (i32.ge_u (local.get $i) (local.get $bytes)))
+            (v128.store (i32.add (local.get $out) (local.get $i))
+              (f32x4.add (v128.load (i32.add (local.get $x) (local.get $i))) (v128.load (i32.add (local.get $row) (local.get $i)))))
+            (local.set $i (i32.add (local.get $i) (i32.const 16)))
+            (br $cols)))
+        (local.set $x (i32.add (local.get $x) (local.get $bytes)))
+        (local.set $out (i32.add (local.get $out) (local.get $bytes)))
+        (br $rows_loop))))
+
   ;; Row-wise LayerNorm of x (rows x d) into out, in float64 (mean, variance, eps as given), any d
   (func $layer_norm_f64 (param $x i32) (param $rows i32) (param $d i32) (param $g i32) (param $b i32) (param $out i32) (param $eps f64)
     (local $t i32) (local $i i32) (local $row i32) (local $mean f64) (local $var f64) (local $c f64) (local $inv f64)

@@ -52,6 +52,19 @@ describe('the SIMD kernel', () => {
     simd.add(sx, simd.place(y), 23);
     jsKernel.add(x, y, 23);
     expect(maxAbsDiff(sx, x)).toBe(0);
+    // One row added to every row (the vertex tokens' a): vectors where d is a multiple of 4, else the TypeScript loop;
+    // the same bits either way, and no row past `rows` written.
+    for (const [rows, d] of [[468, 32], [3, 8], [5, 7]]) {
+      const X = wave(rows * d, 0.37, 2), row = wave(d, 0.91);
+      const want = new Float32Array(rows * d + d);
+      jsKernel.addRow(X, row, rows, d, want);
+      const got = simd.alloc(rows * d + d);
+      simd.addRow(simd.place(X), simd.place(row), rows, d, got);
+      expect(maxAbsDiff(got, want)).toBe(0);
+      expect(want[rows * d + 1]).toBe(0);
+      expect(got[rows * d + 1]).toBe(0);
+      expect(want[d + 1]).toBe(Math.fround(X[d + 1] + row[1]));
+    }
   });
 
   it.each([true, false])('the SIMD attention (fused multiply-adds: %s) equals the TypeScript attention on ragged key lists, large and small scores', (fma) => {
