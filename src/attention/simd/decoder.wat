@@ -50,8 +50,8 @@
             (local.set $wp (i32.add (local.get $wt) (i32.shl (local.get $o) (i32.const 2))))
             (local.set $i (i32.const 0))
             (loop $k_loop
-              (local.set $p (f32x4.splat (f32.load (i32.add (local.get $xp0) (local.get $i)))))
-              (local.set $q (f32x4.splat (f32.load (i32.add (local.get $xp1) (local.get $i)))))
+              (local.set $p (v128.load32_splat (i32.add (local.get $xp0) (local.get $i))))
+              (local.set $q (v128.load32_splat (i32.add (local.get $xp1) (local.get $i))))
               (local.set $w (v128.load offset=0 (local.get $wp)))
               (local.set $a0 (f32x4.add (local.get $a0) (f32x4.mul (local.get $w) (local.get $p))))
               (local.set $c0 (f32x4.add (local.get $c0) (f32x4.mul (local.get $w) (local.get $q))))
@@ -90,9 +90,9 @@
             (loop $k_loop4
               (local.set $w (v128.load (local.get $wp)))
               (local.set $a0 (f32x4.add (local.get $a0)
-                (f32x4.mul (local.get $w) (f32x4.splat (f32.load (i32.add (local.get $xp0) (local.get $i)))))))
+                (f32x4.mul (local.get $w) (v128.load32_splat (i32.add (local.get $xp0) (local.get $i))))))
               (local.set $c0 (f32x4.add (local.get $c0)
-                (f32x4.mul (local.get $w) (f32x4.splat (f32.load (i32.add (local.get $xp1) (local.get $i)))))))
+                (f32x4.mul (local.get $w) (v128.load32_splat (i32.add (local.get $xp1) (local.get $i))))))
               (local.set $wp (i32.add (local.get $wp) (local.get $stride)))
               (local.set $i (i32.add (local.get $i) (i32.const 4)))
               (br_if $k_loop4 (i32.lt_u (local.get $i) (local.get $xrow))))
