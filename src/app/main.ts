@@ -10,9 +10,9 @@ import { TalkingFaceEngine, type Backend } from '../engine/engine';
 import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
 import { decodeAudio } from '../audio/decode';
 import { Player, audioNotes } from '../player/player';
-import { TakeView, redrawHead, type Take } from './take-view';
+import { TakeView, animateAudio, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
-import { fetchSample, fillSampleSelect, type SampleIndex } from './samples';
+import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, switchBackend, takeDetails } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
@@ -116,7 +116,11 @@ function setBusy(controller: AbortController | null): void {
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>): Promise<void> {
   const e = needEngine();
-  if (!e || recording) return;
+  if (!e || recording) {
+    if (recording) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
+    markSample(ui.sampleSelect, sampleIndex, take?.name);
+    return;
+  }
   busy?.abort();
   stopPlayback();
   const controller = new AbortController();
@@ -139,21 +143,6 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   } finally {
     if (busy === controller) setBusy(null);
   }
-}
-
-/** Animate decoded audio with progress in the status line; where no speech is found the face stays at rest. */
-async function animateAudio(e: TalkingFaceEngine, name: string, samples: Float32Array, seconds: number, signal: AbortSignal) {
-  const early = audioNotes(samples, seconds);
-  e.resetTimes();
-  const t0 = performance.now();
-  const animation = await e.animate(samples, {
-    unposed: true,
-    signal,
-    onProgress: (done, total) => showStatus(`Animating ${name}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
-  });
-  const computeMs = performance.now() - t0;
-  const speech = await e.restUnlessSpeech(animation);
-  return { animation, computeMs, notes: audioNotes(samples, seconds, speech) };
 }
 
 function animateFile(file: File): Promise<void> {
@@ -185,6 +174,7 @@ function openSample(name: string): Promise<void> {
 /** A take to show and play: its figures in the details, its most important note (if any) kept for the status line. */
 function setTake(t: Take, notes: string[] = []): Take {
   take = t;
+  markSample(ui.sampleSelect, sampleIndex, t.name);
   player.load(t.animation, t.buffer, takeView.drawn(t));
   publish();
   ui.takeInfo.textContent = takeDetails(t, notes);

@@ -52,6 +52,11 @@ export async function fillSampleSelect(select: HTMLSelectElement): Promise<Sampl
   }
 }
 
+/** The menu names the take when it is a sample, else shows its placeholder (so choosing a sample again is a change). */
+export function markSample(select: HTMLSelectElement, index: SampleIndex | null, name: string | undefined): void {
+  select.value = name && index?.clips.some((c) => c.name === name) ? name : '';
+}
+
 /** A sample's audio bytes and decoded ground truth, both checked against the index. */
 export async function fetchSample(c: SampleEntry, vertices: number, unitsPerMm: number): Promise<{ audio: ArrayBuffer; truth: Truth }> {
   const [audio, truthBytes] = await Promise.all([c.audio, c.ground_truth].map(async (f) => {

@@ -9,7 +9,8 @@ import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { showLegend, ui } from './controls';
+import { showLegend, showStatus, ui } from './controls';
+import { audioNotes } from '../player/player';
 
 export interface Take {
   animation: Animation;
@@ -124,4 +125,19 @@ export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSig
   const t0 = performance.now();
   const animation = await e.animate(t.samples, { unposed: true, signal });
   return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
+}
+
+/** Animate decoded audio with progress in the status line; where no speech is found the face stays at rest. */
+export async function animateAudio(e: TalkingFaceEngine, name: string, samples: Float32Array, seconds: number, signal: AbortSignal) {
+  const early = audioNotes(samples, seconds);
+  e.resetTimes();
+  const t0 = performance.now();
+  const animation = await e.animate(samples, {
+    unposed: true,
+    signal,
+    onProgress: (done, total) => showStatus(`Animating ${name}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
+  });
+  const computeMs = performance.now() - t0;
+  const speech = await e.restUnlessSpeech(animation);
+  return { animation, computeMs, notes: audioNotes(samples, seconds, speech) };
 }

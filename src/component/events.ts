@@ -1,7 +1,8 @@
 /** What <talking-face> sends with its events (docs/embedding.md, "Events"). */
-import type { Backend } from '../engine/engine';
+import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { AvatarSummary } from '../avatar/gltf-avatar';
-import type { FrameWeights } from '../avatar/weights';
+import { frameWeights, type FrameWeights } from '../avatar/weights';
+import { SHORT_CLIP_SECONDS } from '../player/player';
 
 export interface ReadyDetail {
   backend: Backend;
@@ -31,4 +32,23 @@ export interface TalkingFaceErrorDetail {
   message: string;
   /** What failed: loading the model, decoding audio, the microphone, inference, or the avatar. */
   stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar';
+}
+
+/** A frame of a take being played: its compute time and real-time factor (none for a clip too short to say). */
+export function playbackFrameDetail(engine: TalkingFaceEngine, a: Animation, frame: number, computeMs: number, audioSeconds: number): FrameDetail {
+  return {
+    frame, time: frame / a.fps, mode: 'playback', backend: engine.backend,
+    inferenceMs: computeMs / a.frames,
+    realTimeFactor: audioSeconds < SHORT_CLIP_SECONDS ? undefined : audioSeconds / (computeMs / 1000),
+    ...(a.blendshapes && frameWeights(a.blendshapes, frame)),
+  };
+}
+
+/** The last frame of a live chunk (frames first ..), with the stream's measured latency. */
+export function liveFrameDetail(engine: TalkingFaceEngine, first: number, frames: Frames, latencyMs: number | undefined): FrameDetail {
+  const last = frames.count - 1;
+  return {
+    frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs,
+    ...(frames.blendshapes && frameWeights(frames.blendshapes, last)),
+  };
 }

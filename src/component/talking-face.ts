@@ -11,34 +11,26 @@
 import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
-import { frameWeights } from '../avatar/weights';
-import { MAX_HEAD_MOTION_SCALE, TalkingFaceEngine, type Animation, type Backend, type Frames } from '../engine/engine';
+import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
+import { audioInput, backendAttribute, headMotionAttribute } from './attributes';
+import { newCanvas, shadowParts } from './parts';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { sharedEngine } from './engines';
 import { Player, audioNotes, SHORT_CLIP_SECONDS, type PlayerView } from '../player/player';
-import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
+import { liveFrameDetail, playbackFrameDetail, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
 /** The model an element loads when it has no `model` attribute. */
 export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 
-const STYLE = `
-:host { display: block; position: relative; width: 100%; aspect-ratio: 4 / 3; min-height: 160px; background: #15181d; border-radius: 8px; overflow: hidden; contain: content; }
-canvas { display: block; width: 100%; height: 100%; outline: none; }
-canvas:focus-visible { box-shadow: inset 0 0 0 3px #7ab8ff; }
-.status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45); }
-.status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
-:host([hide-status]) .status:not(.error) { display: none; }
-`;
-
 export class TalkingFaceElement extends HTMLElement {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
 
-  private readonly canvas: HTMLCanvasElement;
+  private canvas: HTMLCanvasElement;
   private readonly statusLine: HTMLParagraphElement;
   private view: FaceView | AvatarView | null = null;
   private player: Player | null = null;
@@ -49,24 +41,14 @@ export class TalkingFaceElement extends HTMLElement {
   private computeMs = 0;
   private audioSeconds = 0;
   private generation = 0; // bumps on stop() and on every new speak(): stale work drops its results
+  private work: AbortController | null = null; // the speak() or startMicrophone() under way: stop() aborts it
+  private playingStatus = '';
+  private connected = false; // connectedCallback has run once
   private viewToken = {}; // the view being made (an avatar loads asynchronously)
 
   constructor() {
     super();
-    const root = this.attachShadow({ mode: 'open' });
-    const style = document.createElement('style');
-    style.textContent = STYLE;
-    this.canvas = document.createElement('canvas');
-    this.canvas.setAttribute('part', 'canvas');
-    this.canvas.tabIndex = 0;
-    this.canvas.setAttribute('role', 'img');
-    this.canvas.setAttribute('aria-label', 'Animated 3D face. Drag to orbit, scroll to zoom.');
-    this.statusLine = document.createElement('p');
-    this.statusLine.className = 'status';
-    this.statusLine.setAttribute('part', 'status');
-    this.statusLine.setAttribute('role', 'status');
-    this.statusLine.setAttribute('aria-live', 'polite');
-    root.append(style, this.canvas, this.statusLine);
+    ({ canvas: this.canvas, status: this.statusLine } = shadowParts(this));
   }
 
   /** Resolves with the engine once the model is loaded (rejects if it cannot be). */
@@ -89,6 +71,7 @@ export class TalkingFaceElement extends HTMLElement {
   }
 
   connectedCallback(): void {
+    this.connected = true;
     void this.load().then(
       () => this.afterLoad(),
       () => undefined, // deliberate: load() has already reported the failure (status line and `error` event)
@@ -105,7 +88,8 @@ export class TalkingFaceElement extends HTMLElement {
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
-    if (old === value || !this.isConnected) return;
+    // Before the first connectedCallback (an upgrade calls this first, for every attribute) that call reads them all.
+    if (old === value || !this.isConnected || !this.connected) return;
     if (name === 'model' || name === 'template' || name.startsWith('avatar')) {
       this.stop();
       this.loading = null;
@@ -116,11 +100,13 @@ export class TalkingFaceElement extends HTMLElement {
       this.view?.dispose();
       this.view = null;
       void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() reports its failure
-    } else if (name === 'backend' && this.engine && value) {
-      this.engine.setBackend(value === 'auto' ? (this.engine.backend) : (value as Backend)).then(
-        () => this.setStatus(`Decoder: ${this.engine!.backend}.`),
-        (e: Error) => this.fail('model', `cannot switch to ${value}: ${e.message}`),
-      );
+    } else if (name === 'backend') {
+      // Elements share an engine per model, template and backend: this one takes the engine of its new backend
+      // (the others keep theirs) and keeps its view; `ready` tells the new backend.
+      this.stop();
+      this.loading = null;
+      this.engine = null;
+      void this.load().then(() => this.afterLoad(false), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value && this.engine) {
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
@@ -135,23 +121,15 @@ export class TalkingFaceElement extends HTMLElement {
    * when playback ends (or stop() is called); rejects with a readable Error, also sent as an error event.
    */
   async speak(audio: Blob | AudioBuffer | URL | string): Promise<void> {
+    const { gen, signal } = this.begin();
     const engine = await this.load();
-    this.stop();
-    const gen = ++this.generation;
+    if (gen !== this.generation) return; // stopped (or removed) while the model loaded
     let decoded;
     try {
       this.setStatus('Decoding audio…');
-      let input: Blob | AudioBuffer;
-      if (typeof audio === 'string' || audio instanceof URL) {
-        const url = new URL(String(audio), document.baseURI);
-        const res = await fetch(url).catch((e: Error) => {
-          throw new Error(`could not fetch ${url.pathname}: ${e.message}`);
-        });
-        if (!res.ok) throw new Error(`could not fetch ${url.pathname}: HTTP ${res.status}`);
-        input = await res.blob();
-      } else input = audio;
-      decoded = await decodeAudio(input, engine.manifest.audio.sample_rate);
+      decoded = await decodeAudio(await audioInput(audio), engine.manifest.audio.sample_rate);
     } catch (e) {
+      if (gen !== this.generation) return;
       throw this.fail('audio', `the audio could not be read: ${(e as Error).message}`);
     }
     if (gen !== this.generation) return;
@@ -163,29 +141,40 @@ export class TalkingFaceElement extends HTMLElement {
         unposed: true,
         blendshapes: this.blendshapes,
         headMotionScale: this.headMotionScale,
+        signal,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
       });
       computeMs = performance.now() - t0;
       speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
     } catch (e) {
+      if (gen !== this.generation) return; // stopped: the abort is no failure
       throw this.fail('inference', `animation failed: ${(e as Error).message}`);
     }
     if (gen !== this.generation) return;
+    this.work = null; // animated: stop() from here stops the playback
     const notes = audioNotes(decoded.samples, seconds, speech);
     [this.computeMs, this.audioSeconds] = [computeMs, seconds];
     this.animation = animation;
     this.player?.load(animation, decoded.buffer);
     this.player?.show(0);
     const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
-    this.setStatus(notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`);
+    this.playingStatus = notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`;
+    this.setStatus(this.playingStatus);
     await this.player?.play(0);
+  }
+
+  /** Stop what this element does and claim the next generation for new work, which `signal` cancels. */
+  private begin(): { gen: number; signal: AbortSignal } {
+    this.stop();
+    this.work = new AbortController();
+    return { gen: this.generation, signal: this.work.signal };
   }
 
   /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
   async startMicrophone(): Promise<void> {
+    const { gen } = this.begin();
     const engine = await this.load();
-    this.stop();
-    const gen = ++this.generation;
+    if (gen !== this.generation) return; // stopped (or removed) while the model loaded: the microphone stays closed
     let media: MediaStream;
     try {
       media = await openMicrophone();
@@ -196,31 +185,38 @@ export class TalkingFaceElement extends HTMLElement {
       for (const t of media.getTracks()) t.stop();
       return;
     }
+    let live: LiveSession;
     try {
-      this.live = await engine.listen(media, (first: number, frames: Frames) => {
+      live = await engine.listen(media, (first: number, frames: Frames) => {
         if (gen !== this.generation || !this.player) return;
-        const last = frames.count - 1;
         this.player.showLive(frames);
-        const latency = this.live?.stream.latency;
-        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
-          detail: { frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs: latency?.lastMs,
-            ...(frames.blendshapes && frameWeights(frames.blendshapes, last)) },
-        }));
+        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream.latency?.lastMs) }));
       }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes,
         headMotionScale: this.headMotionScale });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
       throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
     }
+    if (gen !== this.generation) { // stopped while the capture started
+      void live.stop();
+      for (const t of media.getTracks()) t.stop();
+      return;
+    }
+    this.live = live;
+    this.work = null;
     this.setStatus(`Listening (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms, ${engine.backend})…`);
   }
 
   /** Stop playback and the microphone. */
   stop(): void {
     this.generation++;
+    const cancelled = this.work;
+    this.work = null;
+    cancelled?.abort(); // an animation under way stops at its next chunk
     const wasPlaying = this.player?.isPlaying ?? false;
     this.player?.stop();
     if (wasPlaying) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
+    else if (cancelled && !this.live) this.setStatus('Stopped.');
     if (this.live) {
       const live = this.live;
       this.live = null;
@@ -233,7 +229,7 @@ export class TalkingFaceElement extends HTMLElement {
     if (!this.loading) {
       const model = this.getAttribute('model') || DEFAULT_MODEL;
       this.setStatus('Loading the model…');
-      this.loading = sharedEngine(model, this.getAttribute('template'), this.getAttribute('backend') || 'auto').then(
+      this.loading = sharedEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))).then(
         (engine) => {
           this.engine = engine;
           return engine;
@@ -254,29 +250,38 @@ export class TalkingFaceElement extends HTMLElement {
 
   /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
   private get headMotionScale(): number | undefined {
-    const v = this.getAttribute('head-motion')?.trim(), x = Number(v);
-    if (v && Number.isFinite(x) && x >= 0 && x <= MAX_HEAD_MOTION_SCALE) return x;
-    if (v) console.warn(`<talking-face> head-motion="${v}" is not a number from 0 to ${MAX_HEAD_MOTION_SCALE}; using the model's own motion (1)`);
-    return undefined;
+    return headMotionAttribute(this.getAttribute('head-motion'));
   }
 
-  private async afterLoad(): Promise<void> {
-    const engine = this.engine!;
+  /** Show the face and say ready; then follow the microphone (`live`), or speak `src` (`autoplay`, unless `autoplay` is false). */
+  private async afterLoad(autoplay = true): Promise<void> {
+    const engine = this.engine;
+    if (!engine || !this.isConnected) return; // removed (or reloading) while the model loaded: nothing to show or start
     const avatar = this.getAttribute('avatar');
     if (!this.view) {
       const token = (this.viewToken = {});
+      const canvas = newCanvas();
+      this.canvas.replaceWith(canvas);
+      this.canvas = canvas;
       let view: FaceView | AvatarView;
       try {
-        view = avatar ? await AvatarView.load(this.canvas, new URL(avatar, document.baseURI).href, this.getAttribute('avatar-head-bone'))
-          : new FaceView(this.canvas, engine.template);
+        view = avatar ? await AvatarView.load(canvas, new URL(avatar, document.baseURI).href, this.getAttribute('avatar-head-bone'))
+          : new FaceView(canvas, engine.template);
       } catch (e) {
         this.fail(avatar ? 'avatar' : 'model', `${avatar ? 'the avatar cannot be used' : 'the face cannot be drawn here (WebGL unavailable?)'}: ${(e as Error).message}`);
         return;
       }
-      if (token !== this.viewToken || this.view) return view.dispose(); // superseded while the avatar loaded
+      if (token !== this.viewToken || this.view || !this.isConnected) return view.dispose(); // superseded while the avatar loaded
       this.view = view;
-      this.player = new Player(view, engine.unitsPerMm, { onFrame: (f) => this.playbackFrame(f), onEnded: () => this.dispatchEvent(new CustomEvent('ended')) });
+      this.player = new Player(view, engine.unitsPerMm, {
+        onFrame: (f) => this.playbackFrame(f),
+        onEnded: () => this.dispatchEvent(new CustomEvent('ended')),
+        // Autoplay rules: the browser starts sound only after a person's gesture on the page.
+        onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
+        onUnblocked: () => this.setStatus(this.playingStatus),
+      });
     }
+    if (this.engine !== engine) return; // the backend or model changed while the view was made
     engine.restFace().then(
       (rest) => (this.view as PlayerView | null)?.setRestFace?.(rest), // the mouth closed at rest, not the opened template; idle life starts from it
       (e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`),
@@ -289,21 +294,14 @@ export class TalkingFaceElement extends HTMLElement {
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined); // reported by fail()
-    else if (src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined); // reported by fail()
+    else if (autoplay && src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined); // reported by fail()
   }
 
   /** A frame event for each frame shown while playing. */
   private playbackFrame(frame: number): void {
     const a = this.animation;
     if (!a || !this.engine || !this.player?.isPlaying) return;
-    this.dispatchEvent(new CustomEvent<FrameDetail>('frame', {
-      detail: {
-        frame, time: frame / a.fps, mode: 'playback', backend: this.engine.backend,
-        inferenceMs: this.computeMs / a.frames,
-        realTimeFactor: this.audioSeconds < SHORT_CLIP_SECONDS ? undefined : this.audioSeconds / (this.computeMs / 1000),
-        ...(a.blendshapes && frameWeights(a.blendshapes, frame)),
-      },
-    }));
+    this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: playbackFrameDetail(this.engine, a, frame, this.computeMs, this.audioSeconds) }));
   }
 
   private setStatus(text: string, isError = false): void {
@@ -313,6 +311,7 @@ export class TalkingFaceElement extends HTMLElement {
 
   /** Show and dispatch an error; returns it so callers can throw it. */
   private fail(stage: TalkingFaceErrorDetail['stage'], message: string): Error {
+    this.work = null; // failed: nothing left for stop() to cancel
     this.setStatus(message, true);
     this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
     return new Error(message);

@@ -93,15 +93,20 @@ export class DecoderBackends {
 
   /** Offsets and poses of `frames` frames from their hierarchical latents (F x 2d) and pose tokens. */
   async decode(latents: Float32Array, poseToken: Float32Array, frames: number, vertices: number): Promise<DecodeResult> {
-    if (this.gpu) {
+    const gpu = this.gpu;
+    if (gpu) {
       try {
-        return await this.decodeOnGpu(this.gpu, latents, poseToken, frames, vertices);
+        return await this.decodeOnGpu(gpu, latents, poseToken, frames, vertices);
       } catch (e) {
-        // The animation goes on: switch to the CPU decoder for this and every later chunk.
-        this.gpu.destroy();
-        this.gpu = null;
-        this.backend = 'cpu';
-        this.reason = `WebGPU failed (${(e as Error).message}); using the CPU decoder`;
+        // The animation goes on on the CPU decoder. If this decoder is still the one in use, it failed: drop it for
+        // every later chunk too. If set() switched away from it meanwhile (destroying it under this decode), that
+        // is no failure: only this chunk moves.
+        if (this.gpu === gpu) {
+          gpu.destroy();
+          this.gpu = null;
+          this.backend = 'cpu';
+          this.reason = `WebGPU failed (${(e as Error).message}); using the CPU decoder`;
+        }
       }
     }
     if (this.pool && frames > 1) {

@@ -48,7 +48,18 @@ export interface PlayerOptions {
   onFrame?: (frame: number) => void;
   /** Called when playback reaches the end (not on stop(), not when looping). */
   onEnded?: () => void;
+  /**
+   * Called when the browser holds the sound back until a person's gesture on the page (autoplay rules: a page that
+   * plays before any click or key press); playback starts at the next one, and onUnblocked is called.
+   */
+  onBlocked?: () => void;
+  onUnblocked?: () => void;
 }
+
+/** How long a resumed audio context may take to run before it counts as held back by the autoplay rules. */
+const AUTOPLAY_WAIT_MS = 300;
+/** The events that count as a person's gesture for the autoplay rules. */
+const GESTURES = ['pointerdown', 'pointerup', 'keydown', 'touchend'] as const;
 
 interface Playing {
   source: AudioBufferSourceNode;
@@ -139,7 +150,7 @@ export class Player {
     this.context ??= new AudioContext();
     const context = this.context;
     // Deliberate: resume() rejects only when the context is closed, and then start() below throws with the reason.
-    void context.resume().catch(() => undefined); // rejects only on a closed context; start() then throws why
+    const resumed = context.resume().catch(() => undefined); // rejects only on a closed context; start() then throws why
     return new Promise<void>((resolve) => {
       const source = context.createBufferSource();
       source.buffer = this.buffer;
@@ -172,7 +183,25 @@ export class Player {
         requestAnimationFrame(tick);
       };
       requestAnimationFrame(tick);
+      void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
+        if (this.playing === playing && context.state === 'suspended') this.awaitGesture(context, playing);
+      });
     });
+  }
+
+  /** The sound is held back until a gesture: resume the context on the next one (the face follows its clock). */
+  private awaitGesture(context: AudioContext, playing: Playing): void {
+    this.options.onBlocked?.();
+    const forget = () => {
+      for (const g of GESTURES) document.removeEventListener(g, resume, true);
+    };
+    const resume = () => {
+      void context.resume().then(() => {
+        forget();
+        if (this.playing === playing) this.options.onUnblocked?.();
+      }, forget); // rejects only on a closed context (the player disposed): nothing left to play
+    };
+    for (const g of GESTURES) document.addEventListener(g, resume, true);
   }
 
   /** Create and resume the audio output now, within a person's gesture, so a take animated later may play (autoplay rules). */

@@ -15,7 +15,13 @@ test('record: the face follows the microphone live, then the take replays in syn
   await expect(page.locator('#details')).toContainText(/latency \d+ ms/, { timeout: 20_000 });
   const live = await page.locator('#face-canvas').screenshot();
   expect((await imageStats(page, live)).foregroundFraction).toBeGreaterThan(0.15);
-  await page.waitForTimeout(2500);
+  // A sample chosen while recording: the status says to stop first, the menu goes back, the recording goes on.
+  await expect(page.locator('#sample-select option')).not.toHaveCount(1, { timeout: 20_000 });
+  await page.locator('#sample-select').selectOption((await page.locator('#sample-select option').nth(1).getAttribute('value'))!);
+  await expect(page.locator('#status')).toContainText('stop it first');
+  await expect(page.locator('#sample-select')).toHaveValue('');
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'true');
+  await page.waitForTimeout(2000);
   await page.locator('#record-button').click();
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
   await expect(page.locator('#clip-info')).toContainText('Recording');

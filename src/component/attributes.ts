@@ -1,0 +1,33 @@
+/** What <talking-face>'s attributes and speak()'s argument mean, checked: a bad value warns and falls back. */
+import { MAX_HEAD_MOTION_SCALE, type Backend } from '../engine/engine';
+
+const BACKENDS = ['auto', 'cpu', 'webgpu'] as const;
+
+/** The `backend` attribute: auto (absent or empty), cpu or webgpu; anything else warns and means auto. */
+export function backendAttribute(value: string | null): 'auto' | Backend {
+  const v = value?.trim() ?? '';
+  if (!v) return 'auto';
+  if ((BACKENDS as readonly string[]).includes(v)) return v as 'auto' | Backend;
+  console.warn(`<talking-face> backend="${v}" is not one of ${BACKENDS.join(', ')}; using auto`);
+  return 'auto';
+}
+
+/** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
+export function headMotionAttribute(value: string | null): number | undefined {
+  const v = value?.trim(), x = Number(v);
+  if (v && Number.isFinite(x) && x >= 0 && x <= MAX_HEAD_MOTION_SCALE) return x;
+  if (v) console.warn(`<talking-face> head-motion="${v}" is not a number from 0 to ${MAX_HEAD_MOTION_SCALE}; using the model's own motion (1)`);
+  return undefined;
+}
+
+/** speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is another origin's). */
+export async function audioInput(audio: Blob | AudioBuffer | URL | string): Promise<Blob | AudioBuffer> {
+  if (!(typeof audio === 'string' || audio instanceof URL)) return audio;
+  const url = new URL(String(audio), document.baseURI);
+  const shown = url.origin === location.origin ? url.pathname : url.href;
+  const res = await fetch(url).catch((e: Error) => {
+    throw new Error(`could not fetch ${shown}: ${e.message}`);
+  });
+  if (!res.ok) throw new Error(`could not fetch ${shown}: HTTP ${res.status}`);
+  return res.blob();
+}

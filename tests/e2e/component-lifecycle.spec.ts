@@ -1,0 +1,134 @@
+import { resolve } from 'node:path';
+import { test, expect, imageStats } from './fixtures';
+import { fakeMicrophone } from '../../playwright.config';
+
+/**
+ * <talking-face> told to stop, removed, moved or switched while it works (examples/embed.html): it never opens the
+ * microphone or plays after a stop or once removed, stop() cancels an animation under way, one element's backend
+ * leaves the others' alone, and a moved element draws again without WebGL errors.
+ */
+test.use({ launchOptions: fakeMicrophone(resolve(import.meta.dirname, '../fixtures/speech-kal.wav')) });
+
+type FaceEl = HTMLElement & { speak(a: unknown): Promise<void>; startMicrophone(): Promise<void>; stop(): void; currentAnimation: { frames: number } | null; backend: string | null };
+
+/** Every element event by id, and every microphone request, from before the elements upgrade. */
+const WATCH = () => {
+  const seen: Record<string, string[]> = {};
+  const g = globalThis as unknown as { faceEvents: typeof seen; microphoneRequests: number };
+  g.faceEvents = seen;
+  g.microphoneRequests = 0;
+  const getUserMedia = navigator.mediaDevices.getUserMedia.bind(navigator.mediaDevices);
+  navigator.mediaDevices.getUserMedia = (c) => {
+    g.microphoneRequests++;
+    return getUserMedia(c);
+  };
+  for (const type of ['ready', 'frame', 'ended', 'error']) {
+    document.addEventListener(type, (e) => {
+      const id = (e.target as HTMLElement).id;
+      if (id) (seen[id] ??= []).push(type === 'frame' ? `frame:${(e as CustomEvent).detail.mode}` : type === 'ready' ? `ready:${(e as CustomEvent).detail.backend}` : type);
+    }, true);
+  }
+};
+
+const statusOf = (id: string) => `document.getElementById('${id}').shadowRoot.querySelector('p.status').textContent`;
+
+test('stopped or removed before the model is ready: no microphone, no playback', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html', { waitUntil: 'domcontentloaded' });
+  await page.evaluate(() => customElements.whenDefined('talking-face'));
+  // While the model loads: ask for the microphone and the sample, then stop both; and add a live element, then remove it.
+  expect(await page.evaluate(statusOf('left'))).toContain('Loading');
+  await page.evaluate(() => {
+    const gone = document.createElement('talking-face');
+    gone.id = 'gone';
+    gone.setAttribute('live', '');
+    document.body.append(gone);
+    setTimeout(() => gone.remove(), 200);
+  });
+  await page.locator('#mic').click();
+  await page.locator('#speak').click();
+  await page.locator('#stop').click();
+  expect(await page.evaluate(statusOf('left')), 'stopped while the model loaded').not.toContain('Ready');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).left?.some((e) => e.startsWith('ready')) && (await events()).right?.some((e) => e.startsWith('ready')), { timeout: 60_000 }).toBe(true);
+  await page.waitForTimeout(3000); // what a lost stop() would have started by now: the capture, the animation, playback
+  const seen = await events();
+  expect(seen.gone ?? [], 'a removed element sends nothing').toEqual([]);
+  expect(seen.left).not.toContain('frame:playback');
+  expect(seen.right).not.toContain('frame:live');
+  expect(await page.evaluate(() => (globalThis as unknown as { microphoneRequests: number }).microphoneRequests), 'microphone requests').toBe(0);
+  expect(await page.evaluate(statusOf('right'))).not.toContain('Listening');
+  // Asked again once ready, both work.
+  await page.locator('#mic').click();
+  await expect.poll(async () => (await events()).right?.filter((e) => e === 'frame:live').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(5);
+  await page.locator('#stop').click();
+});
+
+test('stop() cancels an animation under way: speak() resolves, the status says so, nothing plays', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html');
+  await expect.poll(() => page.evaluate(statusOf('left')), { timeout: 60_000 }).toContain('Ready');
+  // Two minutes of a voiced sound (a harmonic series whose loudness comes and goes): seconds of work on two cores.
+  const timing = await page.evaluate(async () => {
+    const rate = 16000, seconds = 120;
+    const buffer = new AudioBuffer({ length: rate * seconds, sampleRate: rate, numberOfChannels: 1 });
+    const x = buffer.getChannelData(0);
+    for (let i = 0; i < x.length; i++) {
+      const t = i / rate;
+      x[i] = 0.2 * (0.5 + 0.5 * Math.sin(2 * Math.PI * 3 * t)) * (Math.sin(2 * Math.PI * 140 * t) + 0.5 * Math.sin(2 * Math.PI * 280 * t) + 0.3 * Math.sin(2 * Math.PI * 700 * t));
+    }
+    const left = document.getElementById('left') as unknown as { speak(a: AudioBuffer): Promise<void>; stop(): void };
+    const status = () => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent!;
+    const spoken = left.speak(buffer);
+    while (!status().startsWith('Animating')) await new Promise((r) => setTimeout(r, 50));
+    const stoppedAt = performance.now();
+    left.stop();
+    await spoken;
+    return { resolvedAfterMs: performance.now() - stoppedAt, status: status() };
+  });
+  expect(timing.resolvedAfterMs, 'speak() resolves soon after stop()').toBeLessThan(3000);
+  expect(timing.status).toBe('Stopped.');
+  await page.waitForTimeout(1000);
+  expect(await page.locator('#left').evaluate((el) => (el as FaceEl).currentAnimation)).toBeNull();
+  expect((await page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents)).left).not.toContain('frame:playback');
+});
+
+test('one element\'s backend attribute leaves the others\' engines alone; a bad value warns and means auto', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.addInitScript(WATCH);
+  const warnings: string[] = [];
+  page.on('console', (m) => m.type() === 'warning' && warnings.push(m.text()));
+  await page.goto('/examples/embed.html');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).right?.includes('ready:cpu'), { timeout: 60_000 }).toBe(true);
+  await page.locator('#left').evaluate((el) => el.setAttribute('backend', 'webgpu'));
+  await expect.poll(async () => (await events()).left?.includes('ready:webgpu'), { timeout: 60_000 }).toBe(true);
+  expect(await page.locator('#left').evaluate((el) => (el as FaceEl).backend)).toBe('webgpu');
+  expect(await page.locator('#right').evaluate((el) => (el as FaceEl).backend), 'the other element').toBe('cpu');
+  // Unknown: a warning, and auto (the CPU decoder, the WebGPU adapter here being software).
+  await page.locator('#left').evaluate((el) => el.setAttribute('backend', 'gpu'));
+  await expect.poll(() => warnings.some((w) => w.includes('backend="gpu"')), { timeout: 10_000 }).toBe(true);
+  await expect.poll(() => page.locator('#left').evaluate((el) => (el as FaceEl).backend), { timeout: 60_000 }).toBe('cpu');
+  // Still speaks.
+  await page.locator('#speak').click();
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(5);
+});
+
+test('an element moved in the page draws again, without WebGL errors', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  const gl: string[] = [];
+  page.on('console', (m) => /WebGL|GL_INVALID/.test(m.text()) && !/GPU stall due to ReadPixels/.test(m.text()) && gl.push(m.text()));
+  await page.goto('/examples/embed.html');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(1);
+  await page.evaluate(() => document.body.append(document.getElementById('left')!));
+  await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(2);
+  await page.locator('#speak').click();
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(10);
+  const stats = await imageStats(page, await page.locator('#left').screenshot());
+  expect(stats.foregroundFraction, 'the moved face is drawn').toBeGreaterThan(0.1);
+  expect(gl, 'WebGL messages').toEqual([]);
+});

@@ -1,0 +1,32 @@
+import { resolve } from 'node:path';
+import { test, expect } from './fixtures';
+import { framesOf } from './helpers/audio';
+
+/**
+ * The demo's Decoder menu changed while a clip is being animated on WebGPU (SwiftShader here, slow enough to change
+ * it mid-way): the chunks left go to the CPU decoder and the take is whole; nothing fails.
+ */
+const SPEECH = resolve(import.meta.dirname, '../fixtures/speech-kal.wav');
+
+test('switching to the CPU decoder during a WebGPU animation finishes the take', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const status = page.locator('#status');
+  await page.locator('#backend-select').selectOption('webgpu');
+  await expect(status).toContainText('New animations will use the webgpu decoder', { timeout: 60_000 });
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  // Its first chunk takes the WebGPU decoder tens of seconds here (software); the menu changes while it runs.
+  await expect(status).toContainText('speech-kal.wav', { timeout: 30_000 });
+  await page.waitForTimeout(3000);
+  await expect(page.locator('body')).not.toHaveAttribute('data-take', /./);
+  await page.locator('#backend-select').selectOption('cpu');
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 120_000 });
+  const take = await page.evaluate(() => {
+    const t = (globalThis as unknown as { talkingFace: { take: { animation: { frames: number; pose: Float32Array } } } }).talkingFace.take;
+    return { frames: t.animation.frames, finite: t.animation.pose.every(Number.isFinite) };
+  });
+  expect(take.frames).toBe(framesOf(SPEECH));
+  expect(take.finite).toBe(true);
+  await expect(status).not.toContainText('Could not');
+});

@@ -1,0 +1,41 @@
+import { afterEach, describe, expect, it, vi } from 'vitest';
+import { audioInput, backendAttribute, headMotionAttribute } from '../../../src/component/attributes';
+
+describe('<talking-face> attributes', () => {
+  afterEach(() => vi.unstubAllGlobals());
+
+  it('backend: auto, cpu or webgpu; anything else warns and means auto', () => {
+    const warn = vi.spyOn(console, 'warn').mockImplementation(() => undefined);
+    expect(backendAttribute(null)).toBe('auto');
+    expect(backendAttribute(' ')).toBe('auto');
+    expect(backendAttribute('cpu')).toBe('cpu');
+    expect(backendAttribute('webgpu')).toBe('webgpu');
+    expect(warn).not.toHaveBeenCalled();
+    expect(backendAttribute('gpu')).toBe('auto');
+    expect(warn).toHaveBeenCalledWith(expect.stringContaining('backend="gpu"'));
+    warn.mockRestore();
+  });
+
+  it('head-motion: a number from 0 to 3, else a warning and the model\'s own', () => {
+    const warn = vi.spyOn(console, 'warn').mockImplementation(() => undefined);
+    expect(headMotionAttribute('0.5')).toBe(0.5);
+    expect(headMotionAttribute(null)).toBeUndefined();
+    expect(headMotionAttribute('4')).toBeUndefined();
+    expect(headMotionAttribute('lively')).toBeUndefined();
+    expect(warn).toHaveBeenCalledTimes(2);
+    warn.mockRestore();
+  });
+
+  it('a URL that cannot be fetched is named in the message, with its host when it is another origin\'s', async () => {
+    vi.stubGlobal('document', { baseURI: 'http://page.test/demo/' });
+    vi.stubGlobal('location', { origin: 'http://page.test' });
+    vi.stubGlobal('fetch', async (url: URL) => {
+      if (url.pathname === '/missing.wav') return new Response('', { status: 404 });
+      throw new TypeError('Failed to fetch');
+    });
+    await expect(audioInput('/missing.wav')).rejects.toThrow('could not fetch /missing.wav: HTTP 404');
+    await expect(audioInput('https://elsewhere.test/a.wav')).rejects.toThrow('could not fetch https://elsewhere.test/a.wav: Failed to fetch');
+    const blob = new Blob(['x']);
+    expect(await audioInput(blob)).toBe(blob);
+  });
+});
