@@ -134,6 +134,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
     }
   } catch (err) {
     if (controller.signal.aborted) {
+      if (busy !== controller) return; // another clip took its place: that one speaks for itself
       tell(`Stopped animating ${label}. Open another file or record.`);
       document.body.dataset.take = take ? 'ready' : 'cancelled';
     } else {
