@@ -107,14 +107,16 @@ function needEngine(): TalkingFaceEngine | null {
   return engine;
 }
 
-function setBusy(controller: AbortController | null): void {
+function setBusy(controller: AbortController | null, headRedraw = false): void {
   busy = controller;
   ui.cancelButton.hidden = !controller;
   ui.recordButton.disabled = Boolean(controller);
+  // The head's controls redraw the take: not while another clip is being animated (they would replace it).
+  ui.headRerollButton.disabled = ui.headScale.disabled = (Boolean(controller) && !headRedraw) || !take || !engine?.hasHeadMotion;
 }
 
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
-async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>): Promise<void> {
+async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
   const e = needEngine();
   if (!e || recording) {
     if (recording) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
@@ -124,7 +126,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   busy?.abort();
   stopPlayback();
   const controller = new AbortController();
-  setBusy(controller);
+  setBusy(controller, headRedraw);
   announce(`Animating ${label}…`);
   try {
     const t = await run(e, controller.signal);
@@ -193,7 +195,7 @@ function setTake(t: Take, notes: string[] = []): Take {
 function redrawTakeHead(change: HeadChange): void {
   if (!engine?.hasHeadMotion) return;
   if (change.scale !== undefined) engine.headMotionScale = change.scale;
-  if (take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, Boolean(change.nextSeed))));
+  if (take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, Boolean(change.nextSeed))), true);
 }
 
 function play(): void {

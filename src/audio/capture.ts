@@ -157,6 +157,8 @@ export class AudioCapture {
 
   static async start(stream: MediaStream, sampleRate: number, onSamples: (samples: Float32Array) => void, options: CaptureOptions = {}): Promise<AudioCapture> {
     if (stream.getAudioTracks().length === 0) throw new MicrophoneError('the stream has no audio track');
+    if (!stream.getAudioTracks().some((t) => t.readyState === 'live')) throw new MicrophoneError('the stream\'s audio has ended (its tracks were stopped)');
+    if (options.block !== undefined && !(Number.isInteger(options.block) && options.block > 0)) throw new RangeError(`block must be a whole number of samples, not ${options.block}`);
     let context: AudioContext;
     let source: MediaStreamAudioSourceNode;
     try {

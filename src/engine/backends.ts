@@ -146,7 +146,9 @@ export class DecoderBackends {
   }
 
   /** Switch decoders at run time (the numbers are the same; only speed differs). */
-  async set(backend: Backend): Promise<void> {
+  async set(choice: 'auto' | Backend): Promise<void> {
+    // auto: as at load, WebGPU on a hardware adapter only.
+    const backend = choice === 'auto' ? ((await detectWebGPU()).info?.isFallbackAdapter === false ? 'webgpu' : 'cpu') : choice;
     if (backend === this.backend) return;
     if (backend === 'cpu') {
       this.gpu?.destroy();

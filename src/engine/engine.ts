@@ -26,6 +26,7 @@ import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
 import { poseFrames } from '../pose/posing';
+import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from './checks';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -94,6 +95,7 @@ export class TalkingFaceEngine {
   private constructor(private readonly pipeline: Pipeline) {}
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
+    if (options.backend !== undefined) checkedBackend(options.backend);
     // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
@@ -120,8 +122,8 @@ export class TalkingFaceEngine {
       weights,
     ]);
     const pipeline = new Pipeline(manifest, face, content, pose, decoder, head && new HeadMotion(head, m.d_model));
-    if (options.headMotionSeed !== undefined) pipeline.headSeed = options.headMotionSeed;
     const engine = new TalkingFaceEngine(pipeline);
+    if (options.headMotionSeed !== undefined) engine.headMotionSeed = options.headMotionSeed; // checked as the setter checks
     if (options.headMotionScale !== undefined) engine.headMotionScale = options.headMotionScale;
     return engine;
   }
@@ -210,9 +212,10 @@ export class TalkingFaceEngine {
 
   /** The whole clip, chunk by chunk. `samples` must be mono at manifest.audio.sample_rate. */
   async animate(samples: Float32Array, options: AnimateOptions = {}): Promise<Animation> {
+    checkedSamples(samples, 'animate');
     const n = this.template.vertexCount;
     const F = this.frameCount(samples.length);
-    const chunk = Math.max(1, options.chunkFrames ?? DEFAULT_CHUNK_FRAMES);
+    const chunk = checkedChunk(options.chunkFrames ?? DEFAULT_CHUNK_FRAMES);
     const keep = options.keep ?? true;
     const vertices = keep ? new Float32Array(F * n * 3) : new Float32Array(0);
     const pose = new Float32Array(F * 6);
@@ -246,8 +249,8 @@ export class TalkingFaceEngine {
    * 1-ring. Computed by the reference decoder from exactly the tokens the animation used.
    */
   async attentionAt(samples: Float32Array, frame: number, layer = this.manifest.model.config.layers - 1): Promise<AttentionMaps> {
-    const F = this.frameCount(samples.length);
-    const f = Math.min(Math.max(0, Math.floor(frame)), F - 1);
+    const F = this.frameCount(checkedSamples(samples, 'attentionAt').length);
+    const f = checkedFrame(frame, F);
     const inputs: { tokens?: Float32Array; poseToken?: Float32Array } = {};
     await this.pipeline.produce(this.pipeline.newState(), f, f + 1, samples, 0, samples.length, inputs);
     this.reference ??= new ReferenceDecoder(this.decoderWeights, this.template.adjacency, this.manifest.model.config);
@@ -277,8 +280,8 @@ export class TalkingFaceEngine {
   }
 
   /** Switch decoders at run time (the numbers are the same; only speed differs). */
-  setBackend(backend: Backend): Promise<void> {
-    return this.pipeline.decoders.set(backend);
+  setBackend(backend: 'auto' | Backend): Promise<void> {
+    return this.pipeline.decoders.set(checkedBackend(backend));
   }
 
   /** The face the model makes in silence (I + O in the template's units, the last frame of a second of silence):
@@ -288,7 +291,7 @@ export class TalkingFaceEngine {
     const n3 = this.template.vertexCount * 3;
     this.rest ??= this.animate(new Float32Array(this.manifest.audio.sample_rate), { unposed: true })
       .then((a) => a.unposed!.slice((a.frames - 1) * n3, a.frames * n3));
-    return this.rest;
+    return this.rest.then((r) => r.slice()); // a copy: the cached face stays as computed
   }
 
   /** Whether a clip holds speech (encoders/voice-activity.ts): speech-like frames, and more than one steady sound. */

@@ -6,6 +6,7 @@
  */
 import { DEFAULT_CHUNK_FRAMES, type Pipeline, type ProducerState, type StateOptions } from './pipeline';
 import { yieldToEventLoop, type Frames } from './frames';
+import { checkedSamples } from './checks';
 
 export class StreamSession {
   private buffer = new Float32Array(1 << 16);
@@ -66,7 +67,7 @@ export class StreamSession {
   /** Append mono samples at the model's rate; resolves when every frame they make ready has been emitted. */
   push(samples: Float32Array): Promise<void> {
     if (this.ended) throw new Error('StreamSession: push() after end()');
-    this.append(samples);
+    this.append(checkedSamples(samples, 'StreamSession.push'));
     this.arrivals.push({ end: this.received, time: performance.now() });
     // Pushes that come while a drain runs share one follow-up drain: at most one waits, however fast
     // the pieces come. Each drain first yields to the event loop, so a page stays responsive (promise

@@ -1,0 +1,31 @@
+import { describe, expect, it } from 'vitest';
+import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from '../../../src/engine/checks';
+
+describe('the engine\'s argument checks', () => {
+  it('samples: a Float32Array of finite audio, else an error that names what is wrong', () => {
+    const ok = new Float32Array([0, 0.5, -1, 32767]);
+    expect(checkedSamples(ok, 'animate')).toBe(ok);
+    expect(() => checkedSamples([0, 1], 'animate')).toThrow(TypeError);
+    expect(() => checkedSamples(null, 'animate')).toThrow(/not null/);
+    expect(() => checkedSamples(new Float64Array(4), 'animate')).toThrow(/not Float64Array/);
+    class AudioBuffer {}
+    expect(() => checkedSamples(new AudioBuffer(), 'animate')).toThrow(/not AudioBuffer \(decodeAudio\(\) gives both/);
+    expect(() => checkedSamples(new Float32Array([0, NaN]), 'animate')).toThrow(/sample 1 is NaN/);
+    expect(() => checkedSamples(new Float32Array([Infinity]), 'StreamSession.push')).toThrow(/StreamSession.push: sample 0 is Infinity/);
+    expect(() => checkedSamples(new Float32Array([0, 0, 1e20]), 'animate')).toThrow(RangeError);
+  });
+
+  it('chunk sizes are whole numbers (below 1 means 1); frames finite; backends by name', () => {
+    expect(checkedChunk(96)).toBe(96);
+    expect(checkedChunk(0)).toBe(1);
+    expect(checkedChunk(-5)).toBe(1);
+    for (const bad of [2.5, NaN, 96.2]) expect(() => checkedChunk(bad)).toThrow(/whole number/);
+    expect(checkedFrame(3.7, 10)).toBe(3);
+    expect(checkedFrame(99, 10)).toBe(9);
+    expect(() => checkedFrame(NaN, 10)).toThrow(/frame number from 0 to 9/);
+    expect(checkedBackend('auto')).toBe('auto');
+    expect(checkedBackend('webgpu')).toBe('webgpu');
+    expect(() => checkedBackend('gpu')).toThrow(/'auto', 'cpu' or 'webgpu', not "gpu"/);
+    expect(() => checkedBackend(undefined)).toThrow(RangeError);
+  });
+});
