@@ -187,6 +187,7 @@ function setTake(t: Take, notes: string[] = []): Take {
   ui.headRerollButton.disabled = ui.headScale.disabled = !engine?.hasHeadMotion;
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
+  takeView.setSideBySide(ui.sideCheck.checked, t, false); // the truth pane follows the take
   player.show(0);
   return t;
 }

@@ -9,7 +9,7 @@ import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { showLegend, showStatus, ui } from './controls';
+import { showLegend, showStatus, tell, ui } from './controls';
 import { audioNotes } from '../player/player';
 
 export interface Take {
@@ -105,13 +105,18 @@ export class TakeView {
   }
 
   /** Show or hide the ground truth beside the prediction; says so when the take has none. */
-  setSideBySide(on: boolean, take: Take | null): void {
-    ui.gtView.hidden = !on;
-    if (on && !this.truthView) {
+  /**
+   * The truth beside the prediction, when asked for (`on`) and the take has one: a take without ground truth (a file,
+   * a recording) hides the pane rather than show another clip's truth, and `say` tells the visitor why.
+   */
+  setSideBySide(on: boolean, take: Take | null, say = true): void {
+    const shown = on && Boolean(take?.truth);
+    ui.gtView.hidden = !shown;
+    if (shown && !this.truthView) {
       this.truthView = new FaceView(ui.gtCanvas, this.view.template, { life: false }); // the truth exactly as recorded
       this.truthView.showPoseArrows(ui.arrowsCheck.checked);
     }
-    if (on && !take?.truth) showLegend('Side by side needs a sample clip (it has ground truth).');
+    if (on && !shown && say) tell('Side by side needs a sample clip (it has ground truth): choose one under Sample.');
   }
 }
 

@@ -81,6 +81,15 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   const path = await download.path();
   const { statSync } = await import('node:fs');
   expect(statSync(path!).size).toBe(take.frames * 468 * 3 * 4);
+
+  // A file has no ground truth: the pane goes (it showed the sample's truth, frozen) and the status says why.
+  await page.locator('#file-input').setInputFiles({ name: 'speech.wav', mimeType: 'audio/wav', buffer: wav([speechSamples().samples], speechSamples().rate) });
+  await page.waitForFunction(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.take?.name === 'speech.wav', null, { timeout: 60_000 });
+  await expect(page.locator('#gt-view')).toBeHidden();
+  await page.locator('#side-check').uncheck();
+  await page.locator('#side-check').check();
+  await expect(page.locator('#status')).toContainText('Side by side needs a sample clip');
+  await expect(page.locator('#gt-view')).toBeHidden();
 });
 
 test('a clip longer than a minute exports whole as a compact .glb: 8 morph targets, the deviation measured', async ({ page }) => {
