@@ -1,15 +1,16 @@
 /** What <talking-face>'s attributes and speak()'s argument mean, checked: a bad value warns and falls back. */
 import { MAX_HEAD_MOTION_SCALE, type Backend } from '../engine/engine';
+import { checkedBackend } from '../engine/checks';
 
-const BACKENDS = ['auto', 'cpu', 'webgpu'] as const;
-
-/** The `backend` attribute: auto (absent or empty), cpu or webgpu; anything else warns and means auto. */
+/** The `backend` attribute: auto (absent or empty), cpu or webgpu (the engine's names); anything else warns and means auto. */
 export function backendAttribute(value: string | null): 'auto' | Backend {
   const v = value?.trim() ?? '';
-  if (!v) return 'auto';
-  if ((BACKENDS as readonly string[]).includes(v)) return v as 'auto' | Backend;
-  console.warn(`<talking-face> backend="${v}" is not one of ${BACKENDS.join(', ')}; using auto`);
-  return 'auto';
+  try {
+    return v ? checkedBackend(v) : 'auto';
+  } catch (e) {
+    console.warn(`<talking-face> backend="${v}": ${(e as Error).message}; using auto`);
+    return 'auto';
+  }
 }
 
 /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */

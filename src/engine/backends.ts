@@ -7,7 +7,7 @@ import { FastDecoder } from '../attention/fast-decoder';
 import { DecoderPool } from '../attention/decoder-pool';
 import { GpuDecoder } from '../attention/gpu-decoder';
 import { vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from '../attention/reference';
-import { detectWebGPU, requestSharedDevice, type WebGPUSupport } from '../gpu/capabilities';
+import { detectWebGPU, isHardwareAdapter, requestSharedDevice, type WebGPUSupport } from '../gpu/capabilities';
 import { ModelLoadError } from '../model/artefacts';
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
@@ -44,7 +44,7 @@ export class DecoderBackends {
     options: BackendOptions = {}): Promise<DecoderBackends> {
     const mismatch = vertexEmbeddingMismatch(weights, adjacency.offsets.length - 1, m.d_model);
     if (mismatch) throw new ModelLoadError(mismatch);
-    const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
+    const hardwareGpu = isHardwareAdapter(support);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';
     const wantGpu = options.backend === 'webgpu' || ((options.backend ?? 'auto') === 'auto' && hardwareGpu);
@@ -147,8 +147,7 @@ export class DecoderBackends {
 
   /** Switch decoders at run time (the numbers are the same; only speed differs). */
   async set(choice: 'auto' | Backend): Promise<void> {
-    // auto: as at load, WebGPU on a hardware adapter only.
-    const backend = choice === 'auto' ? ((await detectWebGPU()).info?.isFallbackAdapter === false ? 'webgpu' : 'cpu') : choice;
+    const backend = choice === 'auto' ? (isHardwareAdapter(await detectWebGPU()) ? 'webgpu' : 'cpu') : choice; // as at load
     if (backend === this.backend) return;
     if (backend === 'cpu') {
       this.gpu?.destroy();

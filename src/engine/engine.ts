@@ -16,7 +16,7 @@ import { ContentEncoder } from '../encoders/content';
 import { PoseEncoder } from '../encoders/pose';
 import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeights } from '../attention/reference';
 import { HeadMotion, checkedScale, headMotionParams } from '../pose/head-motion';
-import { detectWebGPU } from '../gpu/capabilities';
+import { detectWebGPU, isHardwareAdapter } from '../gpu/capabilities';
 import type { FaceTemplate } from '../template/face-template';
 import { DecoderBackends, type Backend } from './backends';
 import type { AvatarWeights } from '../avatar/weights';
@@ -100,7 +100,7 @@ export class TalkingFaceEngine {
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
     const gpu = detectWebGPU().then((support) => {
-      const hardwareGpu = Boolean(support.adapter && !support.info?.isFallbackAdapter);
+      const hardwareGpu = isHardwareAdapter(support);
       const providers: ExecutionProvider[] = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
       startOrt(providers); // onnxruntime (its worker, or its script) loads while the files arrive
       return { support, providers };

@@ -14,6 +14,11 @@ export interface WebGPUSupport {
 
 let cached: Promise<WebGPUSupport> | null = null;
 
+/** A hardware adapter: what 'auto' chooses WebGPU for (a software one, SwiftShader, is slower than the CPU path). */
+export function isHardwareAdapter(support: WebGPUSupport): boolean {
+  return Boolean(support.adapter && !support.info?.isFallbackAdapter);
+}
+
 /** Request an adapter once per page; later calls share the answer. */
 export function detectWebGPU(): Promise<WebGPUSupport> {
   cached ??= probe();
