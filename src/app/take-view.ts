@@ -125,11 +125,23 @@ export class TakeView {
  * same seed after its scale changed (`nextSeed` false).
  */
 export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal, nextSeed = true): Promise<Take> {
-  if (nextSeed) e.headMotionSeed = (e.headMotionSeed ?? 0) + 1;
-  document.body.dataset.headSeed = String(e.headMotionSeed);
-  const t0 = performance.now();
-  const animation = await e.animate(t.samples, { unposed: true, signal });
-  return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
+  const shown = e.headMotionSeed;
+  const showSeed = (seed: number | null) => (document.body.dataset.headSeed = String(seed));
+  // Stopped or replaced before it is drawn, the seed goes back to the take's that stays shown, at once (before whatever
+  // replaced it draws): the next New head motion then shows the seed after it instead of skipping one never seen.
+  const undo = () => showSeed((e.headMotionSeed = shown));
+  if (nextSeed) {
+    e.headMotionSeed = (shown ?? 0) + 1;
+    signal.addEventListener('abort', undo, { once: true });
+  }
+  showSeed(e.headMotionSeed);
+  try {
+    const t0 = performance.now();
+    const animation = await e.animate(t.samples, { unposed: true, signal });
+    return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
+  } finally {
+    signal.removeEventListener('abort', undo);
+  }
 }
 
 /** Animate decoded audio with progress in the status line; where no speech is found the face stays at rest. */

@@ -240,6 +240,7 @@ export class TalkingFaceEngine {
       options.onFrames?.(f0, out.vertices, out.pose, out);
       options.onProgress?.(f1, F);
     }
+    options.signal?.throwIfAborted(); // aborted during the last chunk (a short clip has only one): no result
     return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue, speech, blendshapes };
   }
 

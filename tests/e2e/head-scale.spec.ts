@@ -62,3 +62,35 @@ test('the head-motion slider makes the head calmer or livelier and leaves the li
   }, unposed);
   expect(same, 'the unposed face (lips, eyes) does not change with the head').toBe(true);
 });
+
+test('New head motion draws the next seed; one stopped before it is drawn leaves the seed of the head shown', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#sample-select option')).toHaveCount(4);
+  await page.locator('#sample-select').selectOption((await page.locator('#sample-select option').nth(1).getAttribute('value'))!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  const seed = () => page.evaluate(() => (globalThis as unknown as { talkingFace: { engine: { headMotionSeed: number } } }).talkingFace.engine.headMotionSeed);
+  expect(await seed()).toBe(0);
+  const pose = () => page.evaluate(() => Array.from((globalThis as unknown as { talkingFace: TF }).talkingFace.take!.animation.pose));
+  const first = await pose();
+
+  // Stopped at once (Escape, in the same task as the click): the take keeps its head, and so does the seed.
+  await page.evaluate(() => {
+    document.getElementById('head-reroll')!.click();
+    document.dispatchEvent(new KeyboardEvent('keydown', { key: 'Escape', bubbles: true, cancelable: true }));
+  });
+  await expect(page.locator('#status')).toContainText('Stopped animating');
+  expect(await seed(), 'the seed of the head still shown').toBe(0);
+  await expect(page.locator('body')).toHaveAttribute('data-head-seed', '0');
+  expect(await pose()).toEqual(first);
+
+  await page.evaluate(() => Object.assign(globalThis, { previousTake: (globalThis as unknown as { talkingFace: TF }).talkingFace.take }));
+  await page.locator('#head-reroll').click();
+  await page.waitForFunction(() => {
+    const g = globalThis as unknown as { talkingFace: TF; previousTake: Take };
+    return g.talkingFace.take !== g.previousTake && document.body.dataset.take === 'ready';
+  }, null, { timeout: 60_000 });
+  expect(await seed(), 'the next seed, none skipped').toBe(1);
+  expect(await pose()).not.toEqual(first);
+});
