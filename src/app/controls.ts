@@ -32,6 +32,8 @@ export const ui = {
   stage: $<HTMLElement>('stage'),
   dropHint: $<HTMLParagraphElement>('drop-hint'),
   timeline: $<HTMLCanvasElement>('timeline'),
+  details: $<HTMLDetailsElement>('details'),
+  detailsBody: $<HTMLDivElement>('details-body'),
 };
 
 /** What changes when the head's own motion is drawn again: the next seed (New head motion), or its scale (the slider). */

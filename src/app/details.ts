@@ -40,3 +40,31 @@ export function switchBackend(engine: TalkingFaceEngine, want: Backend): void {
     (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),
   );
 }
+
+/**
+ * The opened details lie over the top right of the face's view, as a video player's statistics do, instead of over
+ * the controls (which they covered until closed): placed when opened and as the page resizes or scrolls. Escape
+ * closes them while the focus is on them.
+ */
+export function bindDetailsPanel(): void {
+  const margin = 8;
+  const place = (): void => {
+    if (!ui.details.open) return;
+    const stage = ui.stage.getBoundingClientRect();
+    const top = Math.max(margin, stage.top + margin);
+    const style = ui.detailsBody.style;
+    style.top = `${top}px`;
+    style.right = `${Math.max(margin, document.documentElement.clientWidth - stage.right + margin)}px`;
+    style.width = `${Math.min(stage.width - 2 * margin, Math.max(18 * 16, 0.42 * stage.width))}px`;
+    style.maxHeight = `${Math.max(6 * 16, stage.bottom - top - margin)}px`;
+  };
+  ui.details.addEventListener('toggle', place);
+  addEventListener('resize', place);
+  addEventListener('scroll', place, { passive: true });
+  ui.details.addEventListener('keydown', (ev) => {
+    if (ev.key !== 'Escape' || !ui.details.open) return;
+    ui.details.open = false;
+    ui.details.querySelector('summary')!.focus();
+    ev.preventDefault(); // handled: the page's Escape (stop what runs) does not also act
+  });
+}

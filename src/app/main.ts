@@ -13,7 +13,7 @@ import { Player, audioNotes } from '../player/player';
 import { TakeView, animateAudio, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';
-import { setupDetails, decoderDetails, switchBackend, takeDetails } from './details';
+import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { exportGlbFile, exportRawFile } from './export-ui';
 import { ui, showStatus, tell, announce, lockWidth, bindControls, type HeadChange } from './controls';
@@ -307,6 +307,7 @@ bindControls({
   redrawHead: redrawTakeHead,
 });
 
+bindDetailsPanel();
 bindKeys({
   escape,
   hasTake: () => take !== null,

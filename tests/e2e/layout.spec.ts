@@ -72,3 +72,29 @@ test('the canvas and the controls stay put at idle, animating, playing, recordin
   for (const [state, b] of Object.entries(states)) expect(shifts(idle, b), `shifts while ${state}`).toEqual([]);
   await test.info().attach('error-state.png', { body: await page.screenshot(), contentType: 'image/png' });
 });
+
+test('the details, opened, lie over the face and cover no control, at any width; Escape on them closes them', async ({ page }) => {
+  const controls = 'section.controls button, section.controls select, section.controls input, section.controls .file-button span, #status, #details summary';
+  for (const viewport of [{ width: 1100, height: 760 }, { width: 1920, height: 1080 }, { width: 390, height: 800 }]) {
+    await page.setViewportSize(viewport);
+    await page.goto('/');
+    await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+    await page.locator('#details summary').click();
+    await expect(page.locator('#details .details-body')).toBeVisible();
+    const covered = await page.evaluate((selector) => {
+      const panel = document.querySelector('#details .details-body')!.getBoundingClientRect();
+      const stage = document.getElementById('stage')!.getBoundingClientRect();
+      const hit = [...document.querySelectorAll(selector)].filter((el) => {
+        const r = el.getBoundingClientRect();
+        return r.width > 0 && r.left < panel.right && panel.left < r.right && r.top < panel.bottom && panel.top < r.bottom;
+      }).map((el) => el.id || el.textContent!.trim());
+      const inside = panel.left >= stage.left - 0.5 && panel.right <= stage.right + 0.5 && panel.bottom <= stage.bottom + 0.5;
+      return { hit, inside };
+    }, controls);
+    expect(covered.hit, `controls under the details at ${viewport.width} px`).toEqual([]);
+    expect(covered.inside, `the details within the face's view at ${viewport.width} px`).toBe(true);
+    await page.keyboard.press('Escape'); // the focus is on the summary just clicked
+    await expect(page.locator('#details .details-body')).toBeHidden();
+    await expect(page.locator('#details summary')).toBeFocused();
+  }
+});
