@@ -80,6 +80,11 @@ export class TalkingFaceElement extends HTMLElement {
 
   disconnectedCallback(): void {
     this.stop();
+    this.dropView();
+  }
+
+  /** Stop drawing and playing: the view and the player are disposed, and a view still loading is not shown. */
+  private dropView(): void {
     this.viewToken = {};
     this.player?.dispose();
     this.player = null;
@@ -94,11 +99,7 @@ export class TalkingFaceElement extends HTMLElement {
       this.stop();
       this.loading = null;
       this.engine = null;
-      this.viewToken = {};
-      this.player?.dispose();
-      this.player = null;
-      this.view?.dispose();
-      this.view = null;
+      this.dropView();
       void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'backend') {
       // Elements share an engine per model, template and backend: this one takes the engine of its new backend
