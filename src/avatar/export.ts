@@ -11,16 +11,11 @@ import * as THREE from 'three';
 import type { Animation } from '../engine/frames';
 import type { FaceTemplate } from '../template/face-template';
 import type { ArkitBasis } from './basis';
-import type { BlendshapeFrames } from './weights';
+import { blendshapesOf } from './weights';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS, VISEME_NAMES, arkitIndexOf } from './names';
 import { avatarScene } from './avatar-mesh';
 
 export const BLENDSHAPES_FORMAT = 'talking-face-blendshapes';
-
-function blendshapesOf(animation: Animation): BlendshapeFrames {
-  if (!animation.blendshapes) throw new Error('the animation has no blend-shape output: animate with { blendshapes: true }');
-  return animation.blendshapes;
-}
 
 const round = (x: number) => Math.round(x * 1e5) / 1e5;
 const rows = (values: Float32Array, width: number, frames: number) =>
@@ -71,6 +66,9 @@ export function liveLinkFaceCsv(animation: Animation): string {
 /** .glb: the template with ARKit-named morph targets, their weights animated per frame, the head bone turning. */
 export async function blendshapesGlb(animation: Animation, template: FaceTemplate, basis: ArkitBasis): Promise<ArrayBuffer> {
   const b = blendshapesOf(animation);
+  if (!template?.positions || !basis?.shapes) {
+    throw new TypeError('blendshapesGlb(take, template, basis): give the engine\'s template and engine.avatarWeights.basis (docs/embedding.md)');
+  }
   const { scene, mesh, head } = avatarScene(template, basis, { morphs: 'arkit', name: 'face' });
   const F = animation.frames;
   const times = Float32Array.from({ length: F }, (_, f) => f / animation.fps);

@@ -19,7 +19,10 @@ interface Target {
 }
 
 export interface AvatarSummary {
-  /** Which output drives the face: ARKit weights when the avatar has ARKit targets, else the visemes. */
+  /**
+   * Which output drives the face: ARKit weights when the avatar has ARKit mouth or jaw targets (or no visemes), else
+   * the visemes (with eyeBlinkLeft / eyeBlinkRight, if it has them, still driven as blinks).
+   */
   scheme: 'arkit' | 'visemes';
   /** ARKit (or viseme) names the avatar has, out of 52 (15). */
   matched: string[];
@@ -54,13 +57,15 @@ export class GltfAvatar {
   }
 
   /**
-   * Parse a .glb (or .gltf JSON) and bind it. `source` names the file in messages; `headBone` is the
-   * `avatar-head-bone` attribute (default: a bone named Head or head). Throws AvatarLoadError with what is wrong.
+   * Parse a .glb (or .gltf JSON) and bind it: `data` is the file's bytes (an ArrayBuffer, or a view of them such as
+   * a Uint8Array or Node's Buffer). `source` names the file in messages; `headBone` is the `avatar-head-bone`
+   * attribute (default: a bone named Head or head). Throws AvatarLoadError with what is wrong.
    */
-  static async parse(bytes: ArrayBuffer, source: string, headBone?: string | null): Promise<GltfAvatar> {
-    const head = new Uint8Array(bytes, 0, Math.min(4, bytes.byteLength));
-    const magic = String.fromCharCode(...head);
-    const firstChar = String.fromCharCode(...new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength))).trimStart()[0];
+  static async parse(data: ArrayBuffer | ArrayBufferView, source: string, headBone?: string | null): Promise<GltfAvatar> {
+    const bytes = bufferOf(data, source);
+    const start = new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength));
+    const magic = String.fromCharCode(...start.subarray(0, 4));
+    const firstChar = String.fromCharCode(...start).trimStart()[0];
     if (magic !== 'glTF' && firstChar !== '{') {
       const what = firstChar === '<' ? 'it is an HTML page: is the URL right?' : `a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}`;
       throw new AvatarLoadError(`${source} is not a glTF file (${what}): export the avatar as .glb`);
@@ -95,7 +100,9 @@ export class GltfAvatar {
       throw new AvatarLoadError(`${source} has no morph targets named after ARKit's 52 blend shapes (jawOpen, eyeBlinkLeft, …) ` +
         `or the 15 Oculus visemes (viseme_aa, viseme_PP, …); ${found}. Rename them (docs/embedding.md, "Avatars").`);
     }
-    const scheme = arkit.length ? 'arkit' : 'visemes';
+    // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
+    const arkitMouth = arkit.some((t) => /^(jaw|mouth)/.test(ARKIT_NAMES[t.channel]));
+    const scheme = arkitMouth || !visemes.length ? 'arkit' : 'visemes';
     const targets = scheme === 'arkit' ? arkit : visemes;
     const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
     const matched = [...new Set(targets.map((t) => all[t.channel]))];
@@ -155,6 +162,15 @@ export class GltfAvatar {
   }
 }
 
+/** The file's bytes as an ArrayBuffer of their own (a view's bytes copied out), or a TypeError saying what came. */
+function bufferOf(data: ArrayBuffer | ArrayBufferView, source: string): ArrayBuffer {
+  if (data instanceof ArrayBuffer) return data;
+  if (ArrayBuffer.isView(data)) return new Uint8Array(data.buffer, data.byteOffset, data.byteLength).slice().buffer;
+  const what = data === null ? 'null' : typeof data === 'object' ? (data as object).constructor?.name ?? 'an object' : typeof data;
+  throw new TypeError(`GltfAvatar.parse(${source}): give the file's bytes (an ArrayBuffer or a Uint8Array), not ${what}` +
+    (what === 'Blob' || what === 'File' ? ' (await its arrayBuffer() first)' : ''));
+}
+
 /** The folder a .gltf's external files are read from ('' for a blob: or data: URL, which has none). */
 function folderOf(source: string): string {
   try {
@@ -173,7 +189,9 @@ function findHead(scene: THREE.Object3D, source: string, name?: string | null): 
   const nodes: THREE.Object3D[] = [];
   scene.traverse((o) => nodes.push(o));
   if (name) {
-    const found = nodes.find((o) => o.name === name);
+    // three.js's loader spells node names its own way (`mixamorig:Head` -> `mixamorigHead`): either spelling is found.
+    const sanitised = THREE.PropertyBinding.sanitizeNodeName(name);
+    const found = nodes.find((o) => o.name === name) ?? nodes.find((o) => o.name === sanitised);
     if (!found) {
       const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
       const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);

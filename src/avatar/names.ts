@@ -39,10 +39,11 @@ export type VisemeName = (typeof VISEME_NAMES)[number];
  */
 export function normaliseMorphName(name: string): string {
   let s = name.trim();
-  const cut = Math.max(s.lastIndexOf('.'), s.lastIndexOf(':'), s.lastIndexOf('|'));
-  // A trailing ".L" / ".R" is a side, not a prefix separator.
-  if (cut >= 0 && !/^[.][LRlr]$/.test(s.slice(cut))) s = s.slice(cut + 1);
+  // The side first (a trailing ".L" is a side, not a prefix separator), then the prefix before the last separator
+  // left: `Face.eyeBlink.L` -> `eyeBlinkLeft`.
   s = s.replace(/[._\s-]([LR])$/i, (_, side: string) => (side.toUpperCase() === 'L' ? 'Left' : 'Right'));
+  const cut = Math.max(s.lastIndexOf('.'), s.lastIndexOf(':'), s.lastIndexOf('|'));
+  if (cut >= 0) s = s.slice(cut + 1);
   return s.replace(/[^A-Za-z0-9]/g, '').toLowerCase();
 }
 

@@ -21,7 +21,7 @@
  */
 import * as THREE from 'three';
 import type { Animation } from '../engine/frames';
-import type { BlendshapeFrames } from './weights';
+import { blendshapesOf, type BlendshapeFrames } from './weights';
 import { ARKIT_INDEX, ARKIT_NAMES, type ArkitName } from './names';
 
 /** What the driver uses of a TalkingHead instance: its morph-target state, one entry per name (Appendix F). */
@@ -114,8 +114,7 @@ function set(target: { realtime: number | null; needsUpdate: boolean }, value: n
  * throughout are left out.
  */
 export function talkingHeadAnim(animation: Animation, options: TalkingHeadOptions = {}): { name: string; dt: number[]; vs: Record<string, number[]> } {
-  const b = animation.blendshapes;
-  if (!b) throw new Error('the animation has no blend-shape output: animate with { blendshapes: true }');
+  const b = blendshapesOf(animation);
   const F = animation.frames;
   const A = ARKIT_NAMES.length;
   const round = (x: number) => Math.round(x * 1e5) / 1e5;

@@ -68,6 +68,17 @@ export function yawPitchRoll(pose: ArrayLike<number>, at: number, out: Float32Ar
 }
 
 /** One frame of the output by name, as <talking-face>'s `frame` event carries it. */
+/**
+ * A take's blend-shape output, or an error that says what was given instead: no take yet (null, e.g. an element's
+ * currentAnimation before it has spoken), something that is no take, or a take animated without blend shapes.
+ */
+export function blendshapesOf(animation: { blendshapes?: BlendshapeFrames; frames?: number } | null | undefined): BlendshapeFrames {
+  if (animation == null) throw new TypeError(`no take to export (${animation}): animate or speak first`);
+  if (typeof animation !== 'object' || !Number.isInteger(animation.frames)) throw new TypeError('expected a take (an Animation from animate(), or an element\'s currentAnimation)');
+  if (!animation.blendshapes) throw new Error('the animation has no blend-shape output: animate with { blendshapes: true }');
+  return animation.blendshapes;
+}
+
 export interface FrameWeights {
   /** The 52 ARKit weights by ARKit's names (jawOpen, mouthClose, eyeBlinkLeft, ...). */
   arkit: Record<ArkitName, number>;

@@ -71,10 +71,14 @@ describe('exports', () => {
     expect(j.visemes[16][1]).toBe(1);
     expect(j.head[20][0]).toBeCloseTo(0.2, 5);
     expect(() => blendshapesJson({ ...take(), blendshapes: undefined })).toThrow(/animate with \{ blendshapes: true \}/);
+    // No take yet (an element's currentAnimation before it spoke), or something else: said, not a TypeError on a property.
+    expect(() => blendshapesJson(null as unknown as Animation)).toThrow(/no take to export \(null\): animate or speak first/);
+    expect(() => liveLinkFaceCsv({} as Animation)).toThrow(/expected a take/);
   });
 
   it('.glb: the template with the 52 ARKit targets under a Head bone, the weights and the head keyed per frame', async () => {
     installFileReader();
+    await expect(blendshapesGlb(take(), template, undefined as unknown as typeof basis)).rejects.toThrow(/give the engine's template and engine\.avatarWeights\.basis/);
     const bytes = await blendshapesGlb(take(), template, basis);
     const a = await GltfAvatar.parse(bytes, 'take.glb');
     expect(a.summary).toEqual({ scheme: 'arkit', matched: [...ARKIT_NAMES], headBone: 'Head' });

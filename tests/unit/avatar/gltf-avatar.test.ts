@@ -78,6 +78,32 @@ describe('GltfAvatar', () => {
     expect(a.summary.headBone).toBeNull();
   });
 
+  it('drives the visemes of a viseme rig that also has ARKit blinks, and the blinks as blinks', () => {
+    const names = [...VISEME_NAMES, 'eyeBlinkLeft', 'eyeBlinkRight'];
+    const a = GltfAvatar.bind(fake(names), 'x.glb');
+    expect(a.summary.scheme).toBe('visemes');
+    expect(a.summary.matched).toEqual([...VISEME_NAMES]);
+    expect(a.canBlink).toBe(true);
+    const w = new Float32Array(ARKIT_NAMES.length);
+    w[ARKIT_NAMES.indexOf('eyeBlinkRight')] = 0.7;
+    const v = new Float32Array(VISEME_NAMES.length);
+    v[VISEME_NAMES.indexOf('viseme_PP')] = 0.8;
+    a.setWeights(w, 0, v, 0);
+    expect(influences(a)('viseme_PP')).toBeCloseTo(0.8, 6);
+    expect(influences(a)('eyeBlinkRight')).toBeCloseTo(0.7, 6);
+    // One ARKit mouth shape beside them is an ARKit rig (ARKit wins when it has the mouth).
+    expect(GltfAvatar.bind(fake([...names, 'jawOpen']), 'x.glb').summary.scheme).toBe('arkit');
+  });
+
+  it("takes the file's bytes as an ArrayBuffer, a Uint8Array or Node's Buffer, and says what else it was given", async () => {
+    const b = readFileSync(resolve(ROOT, 'examples/avatars', 'arkit-face.glb')); // a Buffer: a view into a larger pool
+    for (const data of [b, new Uint8Array(b), file('arkit-face.glb')]) {
+      expect((await GltfAvatar.parse(data, 'arkit-face.glb')).summary.matched.length, data.constructor.name).toBe(52);
+    }
+    await expect(GltfAvatar.parse(new Blob([b]) as unknown as ArrayBuffer, 'a.glb')).rejects.toThrow(/give the file's bytes .* not Blob \(await its arrayBuffer\(\) first\)/);
+    await expect(GltfAvatar.parse(null as unknown as ArrayBuffer, 'a.glb')).rejects.toThrow(/not null/);
+  });
+
   it('says what it found when neither scheme is there, and when the file is not glTF', async () => {
     expect(() => GltfAvatar.bind(fake(['smile', 'blink', 'A']), 'face.glb')).toThrow(/face\.glb has no morph targets named after ARKit's 52 .* its morph targets are: smile, blink, A\./);
     expect(() => GltfAvatar.bind(fake([]), 'bare.glb')).toThrow(/it has no morph targets at all/);
@@ -92,6 +118,8 @@ describe('GltfAvatar', () => {
       expect(GltfAvatar.bind(fake(['jawOpen'], [...bones]), 'x.glb').summary.headBone, bones.join('/')).toBe(head);
     }
     expect(GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck', 'Skull']), 'x.glb', 'Skull').summary.headBone).toBe('Skull');
+    // Named as in the file: three.js's loader drops ':' and '.' from node names (mixamorig:Head -> mixamorigHead).
+    expect(GltfAvatar.bind(fake(['jawOpen'], ['mixamorigHips', 'mixamorigHead']), 'x.glb', 'mixamorig:Head').summary.headBone).toBe('mixamorigHead');
     expect(() => GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck']), 'x.glb', 'Skull')).toThrow(/no node named "Skull" \(avatar-head-bone\); its bones are: Hips, Neck/);
   });
 

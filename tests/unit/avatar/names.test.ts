@@ -25,6 +25,10 @@ describe('naming schemes', () => {
     expect(arkitIndexOf('EyeBlink.R')).toBe(ARKIT_NAMES.indexOf('eyeBlinkRight'));
     expect(arkitIndexOf('Mouth_Smile_L')).toBe(ARKIT_NAMES.indexOf('mouthSmileLeft')); // Character Creator's spelling
     expect(arkitIndexOf('blendShape2.mouthSmile_R')).toBe(ARKIT_NAMES.indexOf('mouthSmileRight'));
+    // A prefix and a dotted side together (both dots): the side is read first, then the prefix dropped.
+    expect(arkitIndexOf('Face.eyeBlink.L')).toBe(ARKIT_NAMES.indexOf('eyeBlinkLeft'));
+    expect(arkitIndexOf('Armature|Face.mouthSmile.R')).toBe(ARKIT_NAMES.indexOf('mouthSmileRight'));
+    for (const n of ARKIT_NAMES) expect(arkitIndexOf(`Face.${n.replace(/Left$/, '.L').replace(/Right$/, '.R')}`), n).toBe(ARKIT_NAMES.indexOf(n));
     for (const n of ['mouthSmile', 'smile', 'jawOpened', 'viseme_aa', '']) expect(arkitIndexOf(n), n).toBe(-1);
   });
 
