@@ -17,6 +17,8 @@ import { softwareWebGL } from '../render/software-gl';
 
 /** About a head's bounding radius in metres (glTF's unit). */
 const HEAD_RADIUS = 0.15;
+/** Seconds the face takes back to neutral after speech (setSpeaking(false)), as the template face's (face-view.ts). */
+const BLEND_OUT = 0.4;
 
 export class AvatarView {
   readonly renderer: THREE.WebGLRenderer;
@@ -28,6 +30,14 @@ export class AvatarView {
   private frameHandle = 0;
   private readonly blinks = new Blinks(performance.now());
   private blink = 0;
+  /** The frame last given (weights, visemes, head rotation) and how much of it is shown: 1, fading to 0 (the rest) after speech. */
+  private readonly shown = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length), head: new Float32Array(3) };
+  private readonly scaled = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length) };
+  /** The ARKit weights of the model's face at rest (setRest; 0 until given): what the avatar shows before and after speech. */
+  private readonly rest = new Float32Array(ARKIT_NAMES.length);
+  private speech = 0;
+  private fading = false;
+  private lastTime = -1;
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGL(), alpha: false }); // render/software-gl.ts
@@ -80,18 +90,45 @@ export class AvatarView {
 
   /** The head pose: its rotation turns the head bone; the translation (mm of the template) is not applied. */
   setPose(rx: number, ry: number, rz: number): void {
+    this.shown.head.set([rx, ry, rz]);
     this.avatar.setHeadRotation(rx, ry, rz);
     this.requestRender();
   }
 
   /** Frame `frame` of the blend-shape output onto the avatar's morph targets. */
   setBlendshapes(b: BlendshapeFrames, frame: number): void {
+    this.shown.arkit.set(b.arkit.subarray(frame * ARKIT_NAMES.length, (frame + 1) * ARKIT_NAMES.length));
+    this.shown.visemes.set(b.visemes.subarray(frame * VISEME_NAMES.length, (frame + 1) * VISEME_NAMES.length));
+    [this.speech, this.fading] = [1, false];
     this.avatar.setWeights(b.arkit, frame * ARKIT_NAMES.length, b.visemes, frame * VISEME_NAMES.length);
     this.requestRender();
   }
 
-  /** Back to the avatar's own neutral face. */
+  /**
+   * The weights of the model's face at rest (engine.restArkit(): what frames of silence get, e.g. mouthRollLower about
+   * 0.16): shown while nothing is spoken, so that the avatar does not move when speech starts or ends in a pause.
+   */
+  setRest(arkit: Float32Array): void {
+    this.rest.set(arkit);
+    if (this.speech > 0) return; // speaking: the rest shows once speech ends
+    this.lastTime = -1;
+    this.fade(0); // shown now (speech 0: the rest alone)
+  }
+
+  /**
+   * Speech stopped (false: playback stopped or ended, the microphone closed): the face goes back to rest and the
+   * head to neutral over BLEND_OUT seconds, instead of holding the frame last shown (mid-word, when stopped).
+   */
+  setSpeaking(on: boolean): void {
+    this.fading = !on && this.speech > 0;
+    if (on) this.speech = 1;
+    this.lastTime = -1;
+    this.requestRender();
+  }
+
+  /** Back to the avatar's own neutral face, at once. */
   reset(): void {
+    [this.speech, this.fading] = [0, false];
     this.avatar.reset();
     this.requestRender();
   }
@@ -116,6 +153,7 @@ export class AvatarView {
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
     if (this.controls.update()) this.needsRender = true;
+    if (this.fading) this.fade(performance.now() / 1000);
     const blink = this.avatar.canBlink ? this.blinks.at(performance.now()) : 0;
     if (blink !== this.blink) {
       this.blink = blink;
@@ -126,6 +164,22 @@ export class AvatarView {
     this.needsRender = false;
     this.renderer.render(this.scene, this.camera);
   };
+
+  /** One step of the fade to rest: the frame's weights and head rotation weighed by `speech` against the rest's (visemes: viseme_sil). */
+  private fade(seconds: number): void {
+    const dt = this.lastTime < 0 ? 0 : seconds - this.lastTime;
+    this.lastTime = seconds;
+    this.speech = Math.max(0, this.speech - dt / BLEND_OUT);
+    this.fading = this.speech > 0;
+    const s = this.speech, { arkit, visemes } = this.scaled;
+    for (let k = 0; k < arkit.length; k++) arkit[k] = s * this.shown.arkit[k] + (1 - s) * this.rest[k];
+    for (let k = 0; k < visemes.length; k++) visemes[k] = s * this.shown.visemes[k];
+    visemes[0] += 1 - s; // viseme_sil
+    this.avatar.setWeights(arkit, 0, visemes, 0);
+    const h = this.shown.head;
+    this.avatar.setHeadRotation(s * h[0], s * h[1], s * h[2]);
+    this.needsRender = true;
+  }
 
   private resize(): void {
     fitToCanvas(this.canvas, this.renderer, this.camera);

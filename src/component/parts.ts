@@ -36,3 +36,4 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   root.append(style, canvas, status);
   return { canvas, status };
 }
+

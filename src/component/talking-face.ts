@@ -8,18 +8,18 @@
  * avatar-head-bone, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop().
  * Events: ready, frame, ended, error (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
-import { FaceView } from '../render/face-view';
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio } from '../audio/decode';
 import { audioInput, backendAttribute, headMotionAttribute } from './attributes';
-import { newCanvas, shadowParts } from './parts';
+import { shadowParts } from './parts';
+import { ElementStage } from './stage';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { sharedEngine } from './engines';
-import { Player, audioNotes, SHORT_CLIP_SECONDS, type PlayerView } from '../player/player';
+import { audioNotes, SHORT_CLIP_SECONDS, type PlayerView } from '../player/player';
 import { liveFrameDetail, playbackFrameDetail, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -30,10 +30,8 @@ export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 export class TalkingFaceElement extends HTMLElement {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
 
-  private canvas: HTMLCanvasElement;
   private readonly statusLine: HTMLParagraphElement;
-  private view: FaceView | AvatarView | null = null;
-  private player: Player | null = null;
+  private readonly stage: ElementStage;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
   private live: LiveSession | null = null;
@@ -44,11 +42,18 @@ export class TalkingFaceElement extends HTMLElement {
   private work: AbortController | null = null; // the speak() or startMicrophone() under way: stop() aborts it
   private playingStatus = '';
   private connected = false; // connectedCallback has run once
-  private viewToken = {}; // the view being made (an avatar loads asynchronously)
 
   constructor() {
     super();
-    ({ canvas: this.canvas, status: this.statusLine } = shadowParts(this));
+    const { canvas, status } = shadowParts(this);
+    this.statusLine = status;
+    this.stage = new ElementStage(canvas, {
+      onFrame: (f) => this.playbackFrame(f),
+      onEnded: () => this.dispatchEvent(new CustomEvent('ended')),
+      // Autoplay rules: the browser starts sound only after a person's gesture on the page.
+      onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
+      onUnblocked: () => this.setStatus(this.playingStatus),
+    });
   }
 
   /** Resolves with the engine once the model is loaded (rejects if it cannot be). */
@@ -67,7 +72,7 @@ export class TalkingFaceElement extends HTMLElement {
 
   /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
   get avatar(): GltfAvatar | null {
-    return this.view instanceof AvatarView ? this.view.avatar : null;
+    return this.stage.view instanceof AvatarView ? this.stage.view.avatar : null;
   }
 
   connectedCallback(): void {
@@ -80,16 +85,7 @@ export class TalkingFaceElement extends HTMLElement {
 
   disconnectedCallback(): void {
     this.stop();
-    this.dropView();
-  }
-
-  /** Stop drawing and playing: the view and the player are disposed, and a view still loading is not shown. */
-  private dropView(): void {
-    this.viewToken = {};
-    this.player?.dispose();
-    this.player = null;
-    this.view?.dispose();
-    this.view = null;
+    this.stage.drop();
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
@@ -99,7 +95,7 @@ export class TalkingFaceElement extends HTMLElement {
       this.stop();
       this.loading = null;
       this.engine = null;
-      this.dropView();
+      this.stage.drop();
       void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'backend') {
       // Elements share an engine per model, template and backend: this one takes the engine of its new backend
@@ -155,18 +151,21 @@ export class TalkingFaceElement extends HTMLElement {
     this.work = null; // animated: stop() from here stops the playback
     const notes = audioNotes(decoded.samples, seconds, speech);
     [this.computeMs, this.audioSeconds] = [computeMs, seconds];
+    const player = await this.stage.settled(); // an avatar may still be loading
+    if (gen !== this.generation) return;
+    if (!player) throw this.fail('avatar', this.stage.error ?? 'there is no face to show it on (is the element in the page?)');
     this.animation = animation;
-    this.player?.load(animation, decoded.buffer);
-    this.player?.show(0);
+    player.load(animation, decoded.buffer);
+    player.show(0);
     const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
     this.playingStatus = notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`;
     this.setStatus(this.playingStatus);
-    await this.player?.play(0);
+    await player.play(0);
   }
 
   /** Stop what this element does and claim the next generation for new work, which `signal` cancels. */
   private begin(): { gen: number; signal: AbortSignal } {
-    this.stop();
+    this.halt(false);
     this.work = new AbortController();
     return { gen: this.generation, signal: this.work.signal };
   }
@@ -189,8 +188,8 @@ export class TalkingFaceElement extends HTMLElement {
     let live: LiveSession;
     try {
       live = await engine.listen(media, (first: number, frames: Frames) => {
-        if (gen !== this.generation || !this.player) return;
-        this.player.showLive(frames);
+        if (gen !== this.generation || !this.stage.player) return;
+        this.stage.player.showLive(frames);
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream.latency?.lastMs) }));
       }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes,
         headMotionScale: this.headMotionScale });
@@ -208,22 +207,26 @@ export class TalkingFaceElement extends HTMLElement {
     this.setStatus(`Listening (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms, ${engine.backend})…`);
   }
 
-  /** Stop playback and the microphone. */
+  /** Stop playback and the microphone; the face (or avatar) goes back to rest. */
   stop(): void {
+    this.halt(true);
+  }
+
+  /** Stop what runs; `say`: tell it in the status line (not when new work takes its place: that work speaks). */
+  private halt(say: boolean): void {
     this.generation++;
     const cancelled = this.work;
     this.work = null;
     cancelled?.abort(); // an animation under way stops at its next chunk
-    const wasPlaying = this.player?.isPlaying ?? false;
-    this.player?.stop();
+    const wasPlaying = this.stage.player?.isPlaying ?? false;
+    this.stage.player?.stop();
+    if (wasPlaying || this.live) (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
     if (wasPlaying) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
-    else if (cancelled && !this.live) this.setStatus('Stopped.');
     if (this.live) {
       const live = this.live;
       this.live = null;
-      (this.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
-      void live.stop().then(() => this.setStatus('Stopped listening.'));
-    }
+      void live.stop().then(() => say && this.setStatus('Stopped listening.'));
+    } else if (say && (wasPlaying || cancelled)) this.setStatus('Stopped.');
   }
 
   private load(): Promise<TalkingFaceEngine> {
@@ -258,35 +261,21 @@ export class TalkingFaceElement extends HTMLElement {
   private async afterLoad(autoplay = true): Promise<void> {
     const engine = this.engine;
     if (!engine || !this.isConnected) return; // removed (or reloading) while the model loaded: nothing to show or start
-    const avatar = this.getAttribute('avatar');
-    if (!this.view) {
-      const token = (this.viewToken = {});
-      const canvas = newCanvas();
-      this.canvas.replaceWith(canvas);
-      this.canvas = canvas;
-      let view: FaceView | AvatarView;
+    if (!this.stage.view) {
+      const avatar = this.getAttribute('avatar');
       try {
-        view = avatar ? await AvatarView.load(canvas, new URL(avatar, document.baseURI).href, this.getAttribute('avatar-head-bone'))
-          : new FaceView(canvas, engine.template);
+        if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, this.getAttribute('avatar-head-bone')))) return; // superseded
       } catch (e) {
-        this.fail(avatar ? 'avatar' : 'model', `${avatar ? 'the avatar cannot be used' : 'the face cannot be drawn here (WebGL unavailable?)'}: ${(e as Error).message}`);
+        this.fail(avatar ? 'avatar' : 'model', (e as Error).message);
         return;
       }
-      if (token !== this.viewToken || this.view || !this.isConnected) return view.dispose(); // superseded while the avatar loaded
-      this.view = view;
-      this.player = new Player(view, engine.unitsPerMm, {
-        onFrame: (f) => this.playbackFrame(f),
-        onEnded: () => this.dispatchEvent(new CustomEvent('ended')),
-        // Autoplay rules: the browser starts sound only after a person's gesture on the page.
-        onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
-        onUnblocked: () => this.setStatus(this.playingStatus),
-      });
     }
     if (this.engine !== engine) return; // the backend or model changed while the view was made
-    engine.restFace().then(
-      (rest) => (this.view as PlayerView | null)?.setRestFace?.(rest), // the mouth closed at rest, not the opened template; idle life starts from it
-      (e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`),
-    );
+    // The mouth closed at rest, not the opened template (idle life starts from it); an avatar's rest weights.
+    const view = this.stage.view;
+    const rest = view instanceof AvatarView ? engine.restArkit().then((w) => view.setRest(w))
+      : engine.restFace().then((r) => (view as PlayerView | null)?.setRestFace?.(r));
+    rest.catch((e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`));
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
       detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
@@ -301,7 +290,7 @@ export class TalkingFaceElement extends HTMLElement {
   /** A frame event for each frame shown while playing. */
   private playbackFrame(frame: number): void {
     const a = this.animation;
-    if (!a || !this.engine || !this.player?.isPlaying) return;
+    if (!a || !this.engine || !this.stage.player?.isPlaying) return;
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: playbackFrameDetail(this.engine, a, frame, this.computeMs, this.audioSeconds) }));
   }
 

@@ -25,7 +25,6 @@ import { StreamSession } from './stream';
 import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
-import { poseFrames } from '../pose/posing';
 import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from './checks';
 
 export type { Backend } from './backends';
@@ -90,7 +89,6 @@ export class TalkingFaceEngine {
   static readonly sessionsRequested: Promise<void> = new Promise((resolve) => (markSessionsRequested = resolve));
 
   private reference: ReferenceDecoder | null = null;
-  private rest: Promise<Float32Array> | null = null;
 
   private constructor(private readonly pipeline: Pipeline) {}
 
@@ -178,7 +176,6 @@ export class TalkingFaceEngine {
   set headMotionSeed(seed: number | null) {
     if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
     this.pipeline.headSeed = seed;
-    this.rest = null;
   }
 
   /** How far the head's own motion turns the head in new animations and streams (1: as fitted). */
@@ -188,7 +185,6 @@ export class TalkingFaceEngine {
 
   set headMotionScale(scale: number) {
     this.pipeline.headScale = checkedScale(scale)!;
-    this.rest = null;
   }
 
   /** Template units per mm (the model works in mm; poses carry mm translations). */
@@ -289,10 +285,12 @@ export class TalkingFaceEngine {
    * what a face shows before and between speech, instead of the template, whose mouth was opened for the lips
    * to part. Computed once. */
   restFace(): Promise<Float32Array> {
-    const n3 = this.template.vertexCount * 3;
-    this.rest ??= this.animate(new Float32Array(this.manifest.audio.sample_rate), { unposed: true })
-      .then((a) => a.unposed!.slice((a.frames - 1) * n3, a.frames * n3));
-    return this.rest.then((r) => r.slice()); // a copy: the cached face stays as computed
+    return this.pipeline.restFace().then((r) => r.slice()); // a copy: the cached face stays as computed
+  }
+
+  /** The 52 ARKit weights (ARKIT_NAMES order) of the face at rest, what frames of silence get: an avatar's rest. */
+  restArkit(): Promise<Float32Array> {
+    return this.pipeline.restArkit().then((w) => w.slice());
   }
 
   /** Whether a clip holds speech (encoders/voice-activity.ts): speech-like frames, and more than one steady sound. */
@@ -311,16 +309,12 @@ export class TalkingFaceEngine {
     return speech;
   }
 
-  /** The face at rest on every frame of `animation` (its head poses kept), in place. */
-  async holdRest(animation: Animation): Promise<void> {
-    const rest = await this.restFace();
-    const n3 = rest.length;
-    const mm = this.pipeline.mmPerUnit;
-    const offsets = new Float32Array(animation.frames * n3);
-    for (let f = 0; f < animation.frames; f++) for (let i = 0; i < n3; i++) offsets[f * n3 + i] = rest[i] * mm - this.pipeline.templateMm[i];
-    const posed = poseFrames(this.pipeline.templateMm, offsets, animation.pose, animation.frames, mm);
-    if (animation.vertices.length) animation.vertices.set(posed.vertices);
-    animation.unposed?.set(posed.unposed);
+  /**
+   * The face at rest on every frame of `animation` (its head poses kept), in place; with blend shapes, the ARKit
+   * weights of the rest (restArkit) and the visemes at viseme_sil.
+   */
+  holdRest(animation: Animation): Promise<void> {
+    return this.pipeline.holdRest(animation);
   }
 
   resetTimes(): void {

@@ -15,8 +15,9 @@ import { poseFrames } from '../pose/posing';
 import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
 import { levelAt } from '../encoders/voice-activity';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
-import type { Frames, StageTimes } from './frames';
+import type { Animation, Frames, StageTimes } from './frames';
 import { AvatarWeights } from '../avatar/weights';
+import { ARKIT_NAMES } from '../avatar/names';
 import { LipClosure } from './lip-closure';
 import type { SolverState } from '../avatar/solver';
 
@@ -45,6 +46,8 @@ export class Pipeline {
   /** How far the head's own motion turns the head: 1 as fitted (the corpus's typical speaker), below calmer, above livelier. */
   headScale = 1;
   private avatar: AvatarWeights | null = null;
+  private restWeights: Promise<Float32Array> | null = null;
+  private rest: Promise<Float32Array> | null = null;
   private closure: LipClosure | null | undefined;
 
   constructor(
@@ -106,6 +109,62 @@ export class Pipeline {
   get avatarWeights(): AvatarWeights {
     this.avatar ??= new AvatarWeights(this.template, this.manifest.content_phones);
     return this.avatar;
+  }
+
+  /**
+   * The face the model makes in silence (I + O in the template's units, the last frame of a second of silence, on a
+   * state of its own): what a face shows before and between speech. Computed once; the caller must not change it.
+   */
+  restFace(): Promise<Float32Array> {
+    this.rest ??= (async () => {
+      const silence = new Float32Array(this.manifest.audio.sample_rate);
+      const F = this.frameCount(silence.length);
+      const frames = await this.produce(this.newState(), 0, F, silence, 0, silence.length);
+      const n3 = this.template.vertexCount * 3;
+      return frames.unposed.slice((F - 1) * n3, F * n3);
+    })().catch((e: unknown) => {
+      this.rest = null; // not kept: the next call tries again
+      throw e;
+    });
+    return this.rest;
+  }
+
+  /**
+   * The face at rest on every frame of `animation` (its head poses kept), in place; with blend shapes, the ARKit
+   * weights of the rest (restArkit) and the visemes at viseme_sil.
+   */
+  async holdRest(animation: Animation): Promise<void> {
+    const rest = await this.restFace();
+    const n3 = rest.length;
+    const mm = this.mmPerUnit;
+    const offsets = new Float32Array(animation.frames * n3);
+    for (let f = 0; f < animation.frames; f++) for (let i = 0; i < n3; i++) offsets[f * n3 + i] = rest[i] * mm - this.templateMm[i];
+    const posed = poseFrames(this.templateMm, offsets, animation.pose, animation.frames, mm);
+    if (animation.vertices.length) animation.vertices.set(posed.vertices);
+    animation.unposed?.set(posed.unposed);
+    animation.tongue.fill(0); // at rest, as in silence
+    const b = animation.blendshapes;
+    if (b) {
+      const arkit = await this.restArkit();
+      for (let f = 0; f < animation.frames; f++) b.arkit.set(arkit, f * arkit.length);
+      b.visemes.fill(0);
+      const V = b.visemes.length / animation.frames;
+      for (let f = 0; f < animation.frames; f++) b.visemes[f * V] = 1; // viseme_sil, the first of VISEME_NAMES
+    }
+  }
+
+  /**
+   * The 52 ARKit weights of the face at rest (restFace through the avatar stage's solver: what every frame of silence
+   * gets, the solver's minimiser being unique). Computed once; the caller must not change it.
+   */
+  restArkit(): Promise<Float32Array> {
+    this.restWeights ??= this.restFace().then((rest) => {
+      const out = new Float32Array(ARKIT_NAMES.length);
+      const offsets = Float32Array.from(rest, (x, i) => x * this.mmPerUnit - this.templateMm[i]);
+      this.avatarWeights.solver.solve(offsets, 0, this.avatarWeights.newState(), out);
+      return out;
+    });
+    return this.restWeights;
   }
 
   /**

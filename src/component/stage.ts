@@ -1,0 +1,67 @@
+/**
+ * What a <talking-face> shows on: its canvas, the view drawn there (the model's own face, or a glTF avatar that
+ * loads asynchronously) and the player that drives it. One view at a time; a view superseded while it loads is
+ * dropped quietly, its failure included (the newer one speaks for itself).
+ */
+import { FaceView } from '../render/face-view';
+import { AvatarView } from '../avatar/avatar-view';
+import type { FaceTemplate } from '../template/face-template';
+import { Player, type PlayerOptions } from '../player/player';
+import { newCanvas } from './parts';
+
+export class ElementStage {
+  view: FaceView | AvatarView | null = null;
+  player: Player | null = null;
+  /** Why the last view could not be made, or null. */
+  error: string | null = null;
+  private token = {};
+  private made: Promise<unknown> = Promise.resolve();
+
+  constructor(private canvas: HTMLCanvasElement, private readonly events: PlayerOptions) {}
+
+  /**
+   * Make the view on a fresh canvas (a second WebGL renderer cannot share one: parts.ts) with its player: the avatar
+   * at `avatar` (a URL relative to the page) turned by `headBone`, or else the model's face. Resolves true once it is
+   * shown, false if superseded meanwhile (drop(), another make(), the element removed); rejects with a message for
+   * a person (kept in `error`).
+   */
+  async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, headBone: string | null): Promise<boolean> {
+    const token = (this.token = {});
+    const canvas = newCanvas();
+    this.canvas.replaceWith(canvas);
+    this.canvas = canvas;
+    const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, headBone)
+      : Promise.resolve().then(() => new FaceView(canvas, template));
+    this.made = made;
+    let view: FaceView | AvatarView;
+    try {
+      view = await made;
+    } catch (e) {
+      if (token !== this.token) return false;
+      this.error = `${avatar ? 'the avatar cannot be used' : 'the face cannot be drawn here (WebGL unavailable?)'}: ${(e as Error).message}`;
+      throw new Error(this.error);
+    }
+    if (token !== this.token || this.view || !canvas.isConnected) {
+      view.dispose();
+      return false;
+    }
+    this.view = view;
+    this.player = new Player(view, unitsPerMm, this.events);
+    return true;
+  }
+
+  /** The player once the view being made is there (an avatar still loading is waited for); null where it failed. */
+  async settled(): Promise<Player | null> {
+    await this.made.catch(() => undefined); // deliberate: a failed view has said why (`error`, and make() rejected)
+    return this.player;
+  }
+
+  /** Stop drawing and playing: the view and its player disposed, a view still loading not shown. */
+  drop(): void {
+    [this.token, this.error] = [{}, null];
+    this.player?.dispose();
+    this.player = null;
+    this.view?.dispose();
+    this.view = null;
+  }
+}
