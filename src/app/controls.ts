@@ -39,6 +39,22 @@ export const ui = {
 /** What changes when the head's own motion is drawn again: the next seed (New head motion), or its scale (the slider). */
 export type HeadChange = { nextSeed?: boolean; scale?: number };
 
+/** What the take's controls depend on: a take shown, a clip being animated (and whether it is the head being redrawn), the microphone. */
+export interface ControlsState { take: boolean; busy: boolean; headRedraw: boolean; recording: boolean; headMotion: boolean }
+
+/**
+ * Which controls work now. Playing, scrubbing and exporting need a take, and not the microphone driving the face
+ * (recording, or its take being finished); the head's controls redraw the take, so not while another clip is being
+ * animated (it would replace it); Record not while a clip is animated; Cancel only then.
+ */
+export function enableControls(s: ControlsState): void {
+  const playable = s.take && !s.recording;
+  for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
+  ui.headRerollButton.disabled = ui.headScale.disabled = !playable || !s.headMotion || (s.busy && !s.headRedraw);
+  ui.recordButton.disabled = s.busy;
+  ui.cancelButton.hidden = !s.busy;
+}
+
 /** The head-motion slider's value in words, for screen readers and the details. */
 export function headScaleText(scale: number): string {
   return scale === 1 ? '1 times, as learnt' : scale === 0 ? '0: the head keeps its mean pose' : `${scale} times, ${scale < 1 ? 'calmer' : 'livelier'}`;

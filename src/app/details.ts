@@ -30,11 +30,11 @@ export function takeDetails(t: Take, notes: string[]): string {
   return `${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
 }
 
-/** New animations use decoder `want`: say so, and keep the details' decoder line up to date. */
+/** Decode on `want` from now on (a clip being animated switches at its next chunk): say so, and keep the details' decoder line up to date. */
 export function switchBackend(engine: TalkingFaceEngine, want: Backend): void {
   engine.setBackend(want).then(
     () => {
-      tell(`New animations will use the ${engine.backend} decoder.`);
+      tell(`Decoding on the ${engine.backend === 'cpu' ? 'CPU' : 'WebGPU'} decoder from now on (a clip being animated switches at its next chunk).`);
       ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine));
     },
     (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),

@@ -16,7 +16,7 @@ import * as THREE from 'three';
 import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
-import { motionBasis } from './motion-basis';
+import { motionBasis, type MotionBasisOptions } from './motion-basis';
 import { Head } from '../render/head';
 import { IdleMotion } from '../render/idle-motion';
 
@@ -34,7 +34,8 @@ export interface GlbExport {
   maxErrorMm: number;
 }
 
-export async function exportGlb(animation: Animation, template: FaceTemplate, unitsPerMm: number, name = 'talking-face'): Promise<GlbExport> {
+export async function exportGlb(animation: Animation, template: FaceTemplate, unitsPerMm: number, name = 'talking-face',
+  work: Pick<MotionBasisOptions, 'onProgress' | 'signal'> = {}): Promise<GlbExport> {
   if (!animation.unposed) throw new Error('exportGlb: the animation has no unposed frames');
   const frames = animation.frames;
   if (frames < 1) throw new Error('exportGlb: the animation has no frames');
@@ -65,7 +66,7 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
     weights = new Float32Array(frames * frames);
     for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   } else {
-    const m = motionBasis(D, frames, dims, GLB_COMPONENTS);
+    const m = await motionBasis(D, frames, dims, GLB_COMPONENTS, work);
     const mean = new Float32Array(dims);
     for (let i = 0; i < dims; i++) mean[i] = base[i] + m.mean[i];
     geometry.setAttribute('position', new THREE.BufferAttribute(mean, 3));

@@ -4,16 +4,27 @@ import type { FaceTemplate } from '../template/face-template';
 import { exportGlb, rawFrames, download, GLB_COMPONENTS, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
 
+/** The .glb being prepared (a long clip's takes seconds): Escape cancels it (cancelExport). */
+let exporting: AbortController | null = null;
+
+/** Cancel a .glb being prepared; true if there was one. */
+export function cancelExport(): boolean {
+  exporting?.abort();
+  return exporting !== null;
+}
+
 export async function exportGlbFile(animation: Animation, name: string, template: FaceTemplate, unitsPerMm: number): Promise<void> {
   // Busy, not disabled: a disabled button would drop the keyboard focus.
-  if (ui.exportGlbButton.getAttribute('aria-busy') === 'true') return;
+  if (exporting) return;
+  const controller = (exporting = new AbortController());
   ui.exportGlbButton.setAttribute('aria-busy', 'true');
   try {
-    if (animation.frames > GLB_EXACT_FRAMES) {
-      showStatus(`Preparing the .glb: finding the clip's ${GLB_COMPONENTS} strongest motion components…`);
-      await new Promise((r) => setTimeout(r, 30)); // let the message show before the work
-    }
-    const glb = await exportGlb(animation, template, unitsPerMm);
+    const preparing = `Preparing the .glb: finding the clip's ${GLB_COMPONENTS} strongest motion components`;
+    if (animation.frames > GLB_EXACT_FRAMES) showStatus(`${preparing}… (Escape cancels)`);
+    const glb = await exportGlb(animation, template, unitsPerMm, undefined, {
+      signal: controller.signal,
+      onProgress: (done) => showStatus(`${preparing}: ${Math.round(100 * done)}%… (Escape cancels)`),
+    });
     const file = `${name.replace(/\.[^.]+$/, '')}.glb`;
     download(new Blob([glb.bytes], { type: 'model/gltf-binary' }), file);
     tell(`Saved ${file}: the animation as a glTF model.`);
@@ -23,8 +34,10 @@ export async function exportGlbFile(animation: Animation, name: string, template
           `(largest deviation from the exact frames: ${glb.maxErrorMm.toFixed(2)} mm).`
         : ', one morph target per frame.'));
   } catch (err) {
-    tell(`Export failed: ${(err as Error).message}`, true);
+    if (controller.signal.aborted) tell('Export cancelled.');
+    else tell(`Export failed: ${(err as Error).message}`, true);
   } finally {
+    exporting = null;
     ui.exportGlbButton.removeAttribute('aria-busy');
   }
 }

@@ -15,8 +15,8 @@ import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
-import { exportGlbFile, exportRawFile } from './export-ui';
-import { ui, showStatus, tell, announce, lockWidth, bindControls, type HeadChange } from './controls';
+import { cancelExport, exportGlbFile, exportRawFile } from './export-ui';
+import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, type HeadChange } from './controls';
 import { bindKeys } from './keyboard';
 import { innerLipGaps } from '../template/lip-gap';
 
@@ -32,6 +32,8 @@ let take: Take | null = null;
 let sampleIndex: SampleIndex | null = null;
 let busy: AbortController | null = null;
 let recording: Recording | null = null;
+let finishing = false; // a recording's take being finished
+let headRedraw = false; // the clip being animated is the take's head drawn again
 let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
 /** The current take's most important note about its audio (silent, no speech, clipped, short), or ''. */
 let takeNote = '';
@@ -42,8 +44,7 @@ function publish(): void {
     talkingFace: {
       view, template: view?.template, gpu: lastGpu, engine, take, truthView: takeView?.truthView ?? null,
       exportGlb: async () => (take && engine ? exportGlb(take.animation, view.template, engine.unitsPerMm) : null),
-      inspectGlb,
-      innerLipGaps,
+      inspectGlb, innerLipGaps,
     },
   });
 }
@@ -86,13 +87,10 @@ async function start(): Promise<void> {
     tell('Ready: open or drop an audio file, choose a sample, or press Record.');
     document.body.dataset.engine = 'ready';
     void fillSampleSelect(ui.sampleSelect).then((index) => (sampleIndex = index));
-    engine.restFace().then(
-      (rest) => {
-        view.setRestFace(rest); // the mouth closed at rest, not the opened template
-        document.body.dataset.rest = 'shown';
-      },
-      (err: Error) => tell(`The face at rest could not be computed: ${err.message}`, true),
-    );
+    engine.restFace().then((rest) => {
+      view.setRestFace(rest); // the mouth closed at rest, not the opened template
+      document.body.dataset.rest = 'shown';
+    }, (err: Error) => tell(`The face at rest could not be computed: ${err.message}`, true));
   } catch (e) {
     ui.setupInfo.textContent += ` The model could not be loaded: ${(e as Error).message}.`;
     tell('The model could not be loaded. The face can still be viewed; reload the page to try again (Details says why).', true);
@@ -107,19 +105,20 @@ function needEngine(): TalkingFaceEngine | null {
   return engine;
 }
 
-function setBusy(controller: AbortController | null, headRedraw = false): void {
-  busy = controller;
-  ui.cancelButton.hidden = !controller;
-  ui.recordButton.disabled = Boolean(controller);
-  // The head's controls redraw the take: not while another clip is being animated (they would replace it).
-  ui.headRerollButton.disabled = ui.headScale.disabled = (Boolean(controller) && !headRedraw) || !take || !engine?.hasHeadMotion;
+const refreshControls = (): void => enableControls({ take: Boolean(take), busy: Boolean(busy), headRedraw,
+  recording: Boolean(recording) || finishing, headMotion: Boolean(engine?.hasHeadMotion) });
+
+function setBusy(controller: AbortController | null, isHeadRedraw = false): void {
+  [busy, headRedraw] = [controller, isHeadRedraw];
+  refreshControls();
 }
 
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
   const e = needEngine();
-  if (!e || recording) {
+  if (!e || recording || finishing) {
     if (recording) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
+    else if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
   }
@@ -154,8 +153,8 @@ function animateFile(file: File): Promise<void> {
     const audio = await decodeAudio(file, e.manifest.audio.sample_rate);
     const src = audio.source;
     ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
-    const { animation, computeMs, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
-    return setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
+    const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
+    return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
   });
 }
 
@@ -167,8 +166,8 @@ function openSample(name: string): Promise<void> {
     const { audio: bytes, truth } = await fetchSample(c, view.template.vertexCount, e.unitsPerMm);
     const audio = await decodeAudio(bytes, e.manifest.audio.sample_rate);
     ui.clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}".`;
-    const { animation, computeMs, notes } = await animateAudio(e, 'the sample', audio.samples, c.seconds, signal);
-    const t = setTake({ animation, buffer: audio.buffer, samples: audio.samples, name: c.name, seconds: c.seconds, computeMs, backend: e.backend, truth }, notes);
+    const { animation, computeMs, samples, notes } = await animateAudio(e, 'the sample', audio.samples, c.seconds, signal);
+    const t = setTake({ animation, buffer: audio.buffer, samples, name: c.name, seconds: c.seconds, computeMs, backend: e.backend, truth }, notes);
     ui.takeInfo.textContent += ` E_vl on this clip: ${takeView.lipError(t, e).toFixed(2)} mm.`;
     return t;
   });
@@ -183,8 +182,8 @@ function setTake(t: Take, notes: string[] = []): Take {
   ui.takeInfo.textContent = takeDetails(t, notes);
   ui.exportInfo.textContent = '';
   takeNote = notes.length ? `${t.name}: ${notes[0]}.` : '';
-  for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = false;
-  ui.headRerollButton.disabled = ui.headScale.disabled = !engine?.hasHeadMotion;
+  ui.playButton.textContent = 'Play'; // loading it stopped any playback
+  refreshControls();
   ui.scrub.max = String(t.animation.frames - 1);
   if (engine) takeView.showTimeline(t, engine);
   takeView.setSideBySide(ui.sideCheck.checked, t, false); // the truth pane follows the take
@@ -194,9 +193,7 @@ function setTake(t: Take, notes: string[] = []): Take {
 
 /** The take's head motion drawn again, with the next seed or at a new scale (the lips and eyes do not change). */
 function redrawTakeHead(change: HeadChange): void {
-  if (!engine?.hasHeadMotion) return;
-  if (change.scale !== undefined) engine.headMotionScale = change.scale;
-  if (take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, Boolean(change.nextSeed))), true);
+  if (engine?.hasHeadMotion && take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, change)), true);
 }
 
 function play(): void {
@@ -216,6 +213,7 @@ function stopPlayback(): void {
   if (!player?.isPlaying) return;
   player.stop();
   showPaused('Paused');
+  takeView.paint(take, engine, player.current, false); // an attention map is drawn for the paused frame
 }
 
 /** Record starts and stops the microphone take. The button stays enabled (and keeps the focus) while it changes state. */
@@ -236,7 +234,9 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
   stopPlayback();
   try {
     const r = await Recording.start(e, (f) => player.showLive(f), (err) => tell(`Live animation stopped: ${err.message}`, true));
+    stopPlayback(); // played while the microphone opened
     recording = r;
+    refreshControls();
     ui.recordButton.textContent = 'Stop recording';
     ui.recordButton.setAttribute('aria-pressed', 'true');
     document.body.dataset.recording = 'true';
@@ -254,7 +254,7 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
 }
 
 async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> {
-  recording = null;
+  [recording, finishing] = [null, true];
   ui.recordButton.textContent = 'Record';
   ui.recordButton.setAttribute('aria-pressed', 'false');
   tell('Recording stopped; finishing the take…');
@@ -262,18 +262,22 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));
     if (!done) return tell('The take was too short to animate. Press Record and speak for a moment.', true);
     const speech = await e.restUnlessSpeech(done.animation);
-    const notes = audioNotes(done.samples, done.seconds, speech).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
+    const notes = audioNotes(done.samples, done.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
     setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
     tell(takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';
   } catch (err) {
     tell(`The recording could not be finished: ${(err as Error).message}`, true);
+  } finally {
+    finishing = false;
+    refreshControls();
   }
 }
 
-/** Escape: stop recording, else playback, else the clip being animated. */
+/** Escape: cancel a .glb being prepared, else stop recording, else playback, else the clip being animated. */
 function escape(): boolean {
+  if (cancelExport()) return true;
   if (recording) void toggleRecording();
   else if (player?.isPlaying) stopPlayback();
   else if (busy) busy.abort();
@@ -281,8 +285,8 @@ function escape(): boolean {
   return true;
 }
 
-const togglePlay = (): void => (player?.isPlaying ? stopPlayback() : play());
-const showFrame = (frame: number): void => { stopPlayback(); player.show(frame); };
+const togglePlay = (): void => (player?.isPlaying ? stopPlayback() : recording || finishing ? undefined : play());
+const showFrame = (frame: number): void => { if (!recording && !finishing) { stopPlayback(); player.show(frame); } };
 
 bindControls({
   openFile: (file) => void animateFile(file),

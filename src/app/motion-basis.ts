@@ -5,8 +5,15 @@
  * asks every viewer to support at once, whatever the clip's length.
  *
  * The directions come from subspace iteration (Q <- orth(D^T D Q), a few rounds from a deterministic
- * start), so the cost is linear in the number of frames: O(iterations x frames x dims x K).
+ * start) on at most `fitFrames` frames evenly spread over the clip (a long clip's motion is the same motion again:
+ * 2,048 frames, over a minute, find its directions), then every frame is projected on them: O(iterations x
+ * min(frames, fitFrames) x dims x K + frames x dims x K). It yields to the event loop as it goes (a 10-minute clip
+ * of the whole head is seconds of work), says how far it is, and stops if its signal is aborted.
  */
+import { yieldToEventLoop } from '../engine/frames';
+
+/** The most the page's thread is held between yields (ms). */
+const YIELD_EVERY_MS = 25;
 
 export interface MotionBasis {
   /** (dims) the mean displacement */
@@ -20,10 +27,34 @@ export interface MotionBasis {
   maxError: number;
 }
 
+export interface MotionBasisOptions {
+  /** Rounds of subspace iteration (default 8). */
+  iterations?: number;
+  /** At most this many frames, evenly spread, find the directions (default 2,048). */
+  fitFrames?: number;
+  /** Called now and then with the share of the work done, 0 to 1. */
+  onProgress?: (done: number) => void;
+  signal?: AbortSignal;
+}
+
 /** D: frames x dims displacements (row-major), dims a multiple of 3 (points). */
-export function motionBasis(D: Float32Array, frames: number, dims: number, K: number, iterations = 8): MotionBasis {
+export async function motionBasis(D: Float32Array, frames: number, dims: number, K: number, options: MotionBasisOptions = {}): Promise<MotionBasis> {
   if (D.length !== frames * dims) throw new Error(`motionBasis: ${D.length} values, not ${frames} x ${dims}`);
+  const { iterations = 8, fitFrames = 2048, onProgress, signal } = options;
+  signal?.throwIfAborted();
   K = Math.max(0, Math.min(K, frames, dims));
+  const fit = Array.from({ length: Math.min(frames, fitFrames) }, (_, j) => Math.floor((j * frames) / Math.min(frames, fitFrames)));
+  // Work in frame-rows: each round reads the fitted frames twice; the end, every frame twice.
+  const total = iterations * 2 * fit.length + 2 * frames;
+  let done = 0, lastYield = performance.now();
+  const step = async (rows: number) => {
+    done += rows;
+    if (performance.now() - lastYield < YIELD_EVERY_MS) return;
+    onProgress?.(done / total);
+    await yieldToEventLoop();
+    signal?.throwIfAborted();
+    lastYield = performance.now();
+  };
   const mean = new Float32Array(dims);
   const acc = new Float64Array(dims);
   for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) acc[i] += D[f * dims + i];
@@ -38,10 +69,13 @@ export function motionBasis(D: Float32Array, frames: number, dims: number, K: nu
   orthonormalise(Q, K, dims);
   const P = new Float64Array(frames * K); // D_centred Q^T
   for (let it = 0; it < iterations; it++) {
-    project(D, mean, frames, dims, Q, K, P);
-    // Q <- P^T D_centred (K x dims), then orthonormalise
+    for (const f of fit) {
+      project(D, mean, f, dims, Q, K, P);
+      await step(1);
+    }
+    // Q <- P^T D_centred (K x dims) over the fitted frames, then orthonormalise
     Q.fill(0);
-    for (let f = 0; f < frames; f++) {
+    for (const f of fit) {
       const row = f * dims;
       for (let k = 0; k < K; k++) {
         const p = P[f * K + k];
@@ -49,10 +83,14 @@ export function motionBasis(D: Float32Array, frames: number, dims: number, K: nu
         const q = k * dims;
         for (let i = 0; i < dims; i++) Q[q + i] += p * (D[row + i] - mean[i]);
       }
+      await step(1);
     }
     orthonormalise(Q, K, dims);
   }
-  project(D, mean, frames, dims, Q, K, P);
+  for (let f = 0; f < frames; f++) {
+    project(D, mean, f, dims, Q, K, P);
+    await step(1);
+  }
   // Order by strength (the variance along each direction).
   const strength = Array.from({ length: K }, (_, k) => {
     let s = 0;
@@ -78,19 +116,20 @@ export function motionBasis(D: Float32Array, frames: number, dims: number, K: nu
       const e = Math.hypot(D[f * dims + i] - r[i], D[f * dims + i + 1] - r[i + 1], D[f * dims + i + 2] - r[i + 2]);
       if (e > maxError) maxError = e;
     }
+    await step(1);
   }
+  onProgress?.(1);
   return { mean, basis, coefficients, components: K, maxError };
 }
 
-function project(D: Float32Array, mean: Float32Array, frames: number, dims: number, Q: Float64Array, K: number, P: Float64Array): void {
-  for (let f = 0; f < frames; f++) {
-    const row = f * dims;
-    for (let k = 0; k < K; k++) {
-      const q = k * dims;
-      let s = 0;
-      for (let i = 0; i < dims; i++) s += (D[row + i] - mean[i]) * Q[q + i];
-      P[f * K + k] = s;
-    }
+/** Frame f's coordinates along the K rows of Q, into P. */
+function project(D: Float32Array, mean: Float32Array, f: number, dims: number, Q: Float64Array, K: number, P: Float64Array): void {
+  const row = f * dims;
+  for (let k = 0; k < K; k++) {
+    const q = k * dims;
+    let s = 0;
+    for (let i = 0; i < dims; i++) s += (D[row + i] - mean[i]) * Q[q + i];
+    P[f * K + k] = s;
   }
 }
 

@@ -9,8 +9,9 @@ import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { showLegend, showStatus, tell, ui } from './controls';
+import { headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
 import { audioNotes } from '../player/player';
+import { raiseIfQuiet } from '../audio/decode';
 
 export interface Take {
   animation: Animation;
@@ -120,33 +121,51 @@ export class TakeView {
   }
 }
 
+/** The head-motion slider at `scale`, and the page's record of the seed (the e2e tests read it). */
+function showHead(seed: number | null, scale: number): void {
+  document.body.dataset.headSeed = String(seed);
+  ui.headScale.value = String(scale);
+  ui.headScale.setAttribute('aria-valuetext', headScaleText(scale));
+}
+
 /**
- * The take with the head's own motion drawn again (the lips and eyes do not change): with the next seed, or with the
- * same seed after its scale changed (`nextSeed` false).
+ * The take with the head's own motion drawn again (the lips and eyes do not change): with the next seed, and / or
+ * at a new scale (the slider).
  */
-export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal, nextSeed = true): Promise<Take> {
-  const shown = e.headMotionSeed;
-  const showSeed = (seed: number | null) => (document.body.dataset.headSeed = String(seed));
-  // Stopped or replaced before it is drawn, the seed goes back to the take's that stays shown, at once (before whatever
-  // replaced it draws): the next New head motion then shows the seed after it instead of skipping one never seen.
-  const undo = () => showSeed((e.headMotionSeed = shown));
-  if (nextSeed) {
-    e.headMotionSeed = (shown ?? 0) + 1;
-    signal.addEventListener('abort', undo, { once: true });
-  }
-  showSeed(e.headMotionSeed);
+export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSignal, change: HeadChange): Promise<Take> {
+  const shown = { seed: e.headMotionSeed, scale: e.headMotionScale };
+  // Stopped or replaced before it is drawn, the seed and scale go back to the take's that stays shown, the slider
+  // with them, at once (before whatever replaced it draws): the next New head motion then shows the seed after it
+  // instead of skipping one never seen, and the slider says what is shown.
+  const undo = () => {
+    [e.headMotionSeed, e.headMotionScale] = [shown.seed, shown.scale];
+    showHead(shown.seed, shown.scale);
+  };
+  if (change.nextSeed) e.headMotionSeed = (shown.seed ?? 0) + 1;
+  if (change.scale !== undefined) e.headMotionScale = change.scale;
+  signal.addEventListener('abort', undo, { once: true });
+  showHead(e.headMotionSeed, e.headMotionScale);
+  showStatus(`Drawing the head's motion again${change.scale !== undefined ? ` at ${headScaleText(e.headMotionScale)}` : ''}…`);
   try {
     const t0 = performance.now();
-    const animation = await e.animate(t.samples, { unposed: true, signal });
+    const animation = await e.animate(t.samples, {
+      unposed: true,
+      signal,
+      onProgress: (done, total) => showStatus(`Drawing the head's motion again: frame ${done} of ${total}…`),
+    });
     return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
   } finally {
     signal.removeEventListener('abort', undo);
   }
 }
 
-/** Animate decoded audio with progress in the status line; where no speech is found the face stays at rest. */
-export async function animateAudio(e: TalkingFaceEngine, name: string, samples: Float32Array, seconds: number, signal: AbortSignal) {
-  const early = audioNotes(samples, seconds);
+/**
+ * Animate decoded audio with progress in the status line (a quiet clip raised first: `samples` returns what was
+ * animated, the take's); where no speech is found the face stays at rest.
+ */
+export async function animateAudio(e: TalkingFaceEngine, name: string, given: Float32Array, seconds: number, signal: AbortSignal) {
+  const { samples, gainDb } = raiseIfQuiet(given);
+  const early = audioNotes(given, seconds, { raisedDb: gainDb, animating: true });
   e.resetTimes();
   const t0 = performance.now();
   const animation = await e.animate(samples, {
@@ -156,5 +175,5 @@ export async function animateAudio(e: TalkingFaceEngine, name: string, samples: 
   });
   const computeMs = performance.now() - t0;
   const speech = await e.restUnlessSpeech(animation);
-  return { animation, computeMs, notes: audioNotes(samples, seconds, speech) };
+  return { animation, computeMs, samples, notes: audioNotes(given, seconds, { speech, raisedDb: gainDb }) };
 }

@@ -35,6 +35,7 @@ export class LipTimeline {
   private readonly offscreen = document.createElement('canvas');
   private data: TimelineData | null = null;
   private frames = 0;
+  private playhead = 0; // the frame the playhead is at (a redraw after a resize keeps it)
 
   constructor(private readonly canvas: HTMLCanvasElement) {
     this.clear();
@@ -42,6 +43,7 @@ export class LipTimeline {
 
   show(data: TimelineData): void {
     this.data = data;
+    this.playhead = 0;
     this.frames = data.gap.length;
     this.redraw();
   }
@@ -64,10 +66,11 @@ export class LipTimeline {
     this.offscreen.width = width;
     this.offscreen.height = height;
     this.drawCurves(this.offscreen.getContext('2d')!, width, height, this.data);
-    this.setPlayhead(0);
+    this.setPlayhead(this.playhead);
   }
 
   setPlayhead(frame: number): void {
+    this.playhead = frame;
     if (!this.data) return;
     const ctx = this.canvas.getContext('2d')!;
     const { width, height } = this.size();

@@ -61,3 +61,21 @@ export function levels(samples: Float32Array): { peak: number; rms: number; clip
   }
   return { peak, rms: Math.sqrt(sum / Math.max(1, samples.length)), clipped: clipped / Math.max(1, samples.length) };
 }
+
+/** Below this peak (-30 dBFS) a clip is quiet: raised for the model (raiseIfQuiet). */
+export const QUIET_PEAK = 0.0316;
+/** Below this peak a clip is silent (-60 dBFS): left as it is, and said so. */
+export const SILENT_PEAK = 1e-3;
+const RAISED_PEAK = 0.5;
+
+/**
+ * A quiet clip (peak between SILENT_PEAK and QUIET_PEAK) raised to a peak of -6 dBFS, for the model, with the gain in
+ * dB; any other as it is (gain 0). Quiet speech otherwise falls below the voice detector's level (a frame RMS of
+ * about -50 dBFS, encoders/voice-activity.ts) and is taken for no speech: the mouth would stay shut.
+ */
+export function raiseIfQuiet(samples: Float32Array): { samples: Float32Array; gainDb: number } {
+  const { peak } = levels(samples);
+  if (peak < SILENT_PEAK || peak >= QUIET_PEAK) return { samples, gainDb: 0 };
+  const gain = RAISED_PEAK / peak;
+  return { samples: samples.map((x) => x * gain), gainDb: 20 * Math.log10(gain) };
+}

@@ -12,7 +12,7 @@ import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { decodeAudio } from '../audio/decode';
+import { decodeAudio, raiseIfQuiet } from '../audio/decode';
 import { audioInput, backendAttribute, headMotionAttribute } from './attributes';
 import { shadowParts } from './parts';
 import { ElementStage } from './stage';
@@ -132,9 +132,10 @@ export class TalkingFaceElement extends HTMLElement {
     if (gen !== this.generation) return;
     const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
     const t0 = performance.now();
+    const quiet = raiseIfQuiet(decoded.samples); // quiet speech would be taken for none
     let animation: Animation, computeMs: number, speech: boolean;
     try {
-      animation = await engine.animate(decoded.samples, {
+      animation = await engine.animate(quiet.samples, {
         unposed: true,
         blendshapes: this.blendshapes,
         headMotionScale: this.headMotionScale,
@@ -149,7 +150,7 @@ export class TalkingFaceElement extends HTMLElement {
     }
     if (gen !== this.generation) return;
     this.work = null; // animated: stop() from here stops the playback
-    const notes = audioNotes(decoded.samples, seconds, speech);
+    const notes = audioNotes(decoded.samples, seconds, { speech, raisedDb: quiet.gainDb });
     [this.computeMs, this.audioSeconds] = [computeMs, seconds];
     const player = await this.stage.settled(); // an avatar may still be loading
     if (gen !== this.generation) return;

@@ -226,6 +226,7 @@ export class TalkingFaceEngine {
       options.signal?.throwIfAborted();
       const f1 = Math.min(F, f0 + chunk);
       const out = await this.pipeline.produce(state, f0, f1, samples, 0, samples.length);
+      options.signal?.throwIfAborted(); // aborted during the chunk: no progress or frames after it (nor a result)
       pose.set(out.pose, f0 * 6);
       if (keep) vertices.set(out.vertices, f0 * n * 3);
       unposed?.set(out.unposed, f0 * n * 3);
@@ -236,7 +237,6 @@ export class TalkingFaceEngine {
       options.onFrames?.(f0, out.vertices, out.pose, out);
       options.onProgress?.(f1, F);
     }
-    options.signal?.throwIfAborted(); // aborted during the last chunk (a short clip has only one): no result
     return { fps: this.fps, frames: F, vertices, pose, unposed, phones, tongue, speech, blendshapes };
   }
 

@@ -5,7 +5,7 @@
  */
 import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
-import { levels } from '../audio/decode';
+import { SILENT_PEAK, levels } from '../audio/decode';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -28,18 +28,29 @@ export const LONG_CLIP_SECONDS = 120;
 /** Shorter clips get a note, and no speed figure (a few frames measure start-up, not speed). */
 export const SHORT_CLIP_SECONDS = 0.5;
 
+/** What audioNotes knows besides the samples. */
+export interface NoteOptions {
+  /** Whether speech was found (the engine's hasSpeech, once animated; default true). */
+  speech?: boolean;
+  /** The gain a quiet clip was raised by for the model (raiseIfQuiet; default 0). */
+  raisedDb?: number;
+  /** Notes while it is being animated: a long clip says it can be cancelled (default false). */
+  animating?: boolean;
+}
+
 /**
- * Notes for a person about a clip's audio: silent, no speech in it (`speech`: the engine's hasSpeech, once
- * animated), clipped, very short, long. Empty when there is nothing to say.
+ * Notes for a person about a clip's audio, the most important first: silent, no speech in it, raised because it was
+ * quiet, clipped, very short; long (while animating). Empty when there is nothing to say.
  */
-export function audioNotes(samples: Float32Array, seconds: number, speech = true): string[] {
+export function audioNotes(samples: Float32Array, seconds: number, { speech = true, raisedDb = 0, animating = false }: NoteOptions = {}): string[] {
   const lv = levels(samples);
   const notes: string[] = [];
-  if (lv.peak < 1e-3) notes.push('the audio is silent, so the mouth stays closed');
+  if (lv.peak < SILENT_PEAK) notes.push('the audio is silent, so the mouth stays closed');
   else if (!speech) notes.push('no speech was found in it (noise, music or a tone?), so the mouth stays at rest');
+  if (lv.peak >= SILENT_PEAK && raisedDb > 0) notes.push(`very quiet (peak ${(20 * Math.log10(lv.peak)).toFixed(0)} dBFS): raised by ${raisedDb.toFixed(0)} dB to animate it`);
   if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of the samples are clipped (distorted); the motion may be less accurate`);
   if (seconds < SHORT_CLIP_SECONDS) notes.push(`a very short clip (${seconds.toFixed(2)} s): too short to show much`);
-  if (seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it is animated in chunks with bounded memory; Cancel stops it`);
+  if (animating && seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it is animated in chunks with bounded memory; Cancel stops it`);
   return notes;
 }
 

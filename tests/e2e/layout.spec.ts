@@ -98,3 +98,23 @@ test('the details, opened, lie over the face and cover no control, at any width;
     await expect(page.locator('#details summary')).toBeFocused();
   }
 });
+
+test('on a phone the status line stays on screen, scrolled or not, and covers no control once scrolled to the end', async ({ page }) => {
+  await page.setViewportSize({ width: 360, height: 640 });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  for (const y of [0, 10_000]) {
+    await page.evaluate((top) => scrollTo(0, top), y);
+    const r = await page.evaluate(() => {
+      const s = document.getElementById('status')!.getBoundingClientRect();
+      const bar = document.querySelector('.status-bar')!.getBoundingClientRect();
+      const under = [...document.querySelectorAll('section.controls button, section.controls select, section.controls input:not([type=file]), .file-button span')]
+        .filter((el) => { const b = el.getBoundingClientRect(); return b.bottom > bar.top && b.top < bar.bottom; }).map((el) => el.id || el.textContent);
+      return { top: s.top, bottom: s.bottom, height: innerHeight, under, page: document.documentElement.scrollHeight };
+    });
+    expect(r.page, 'the page scrolls at this size').toBeGreaterThan(r.height);
+    expect(r.top, `status top, scrolled to ${y}`).toBeGreaterThanOrEqual(0);
+    expect(r.bottom, `status bottom, scrolled to ${y}`).toBeLessThanOrEqual(r.height);
+    if (y > 0) expect(r.under, 'controls under the status bar at the end of the page').toEqual([]);
+  }
+});

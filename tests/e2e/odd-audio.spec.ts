@@ -36,6 +36,18 @@ test.describe('odd audio', () => {
     });
   }
 
+  test('quiet speech (peak -45 dBFS) is raised for the model and said so, and moves the mouth as speech', async ({ page }) => {
+    const { samples, rate } = speechSamples();
+    const peak = Math.max(...samples.map(Math.abs));
+    const quiet = samples.map((x) => (x / peak) * 10 ** (-45 / 20));
+    await page.locator('#file-input').setInputFiles({ name: 'quiet.wav', mimeType: 'audio/wav', buffer: wav([quiet], rate) });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#details')).toContainText(/very quiet \(peak -45 dBFS\): raised by 39 dB/);
+    await expect(page.locator('#details')).not.toContainText('no speech');
+    const gaps = await lipGaps(page);
+    expect(Math.max(...gaps) - Math.min(...gaps), 'speech moves the mouth (mm)').toBeGreaterThan(2);
+  });
+
   test('a 0.2 s clip gets a note and no real-time factor', async ({ page }) => {
     const { samples, rate } = speechSamples();
     await page.locator('#file-input').setInputFiles({ name: 'tiny.wav', mimeType: 'audio/wav', buffer: wav([samples.subarray(rate, rate + rate / 5)], rate) });

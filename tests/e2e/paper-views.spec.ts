@@ -57,6 +57,16 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   const box = (await page.locator('#face-canvas').boundingBox())!;
   await page.mouse.click(box.x + box.width / 2, box.y + box.height * 0.45);
   await expect(page.locator('#legend')).toContainText(/Vertex \d+'s attention over itself and its \d+ neighbours/);
+  // Chosen while the take plays, an attention map waits for a paused frame, and is drawn when it is paused.
+  await page.locator('#paint-select').selectOption('none');
+  await page.evaluate(() => delete document.body.dataset.painted);
+  await page.locator('#loop-check').check(); // so that it is still playing when paused below
+  await page.locator('#play-button').click();
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+  await page.locator('#paint-select').selectOption('pose-attention');
+  await expect(page.locator('#legend')).toContainText('pause or scrub');
+  await page.locator('#play-button').click();
+  await expect(page.locator('body')).toHaveAttribute('data-painted', 'pose-attention', { timeout: 30_000 });
   await test.info().attach('attention.png', { body: await page.locator('#stage').screenshot(), contentType: 'image/png' });
 
   // .glb: re-loads in three.js with the whole head, one morph target per frame and the clip's duration.

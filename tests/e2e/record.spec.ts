@@ -56,3 +56,37 @@ test('record: the face follows the microphone live, then the take replays in syn
   await page.locator('#scrub').fill(String(FPS));
   await expect(page.locator('#time-label')).toHaveText('1.00 s');
 });
+
+test("while recording, the last take's playback rests; a file opened while the recording is finished waits for it", async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#sample-select option')).not.toHaveCount(1, { timeout: 20_000 });
+  await page.locator('#sample-select').selectOption((await page.locator('#sample-select option').nth(1).getAttribute('value'))!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await page.locator('#record-button').click();
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
+  for (const id of ['#play-button', '#scrub', '#export-glb', '#export-raw', '#head-reroll']) await expect(page.locator(id), id).toBeDisabled();
+  await page.locator('#face-canvas').focus();
+  await page.keyboard.press('Space'); // play, by keyboard: not while the microphone drives the face
+  await page.waitForTimeout(500);
+  await expect(page.locator('#play-button')).toHaveText('Play');
+  await expect(page.locator('#status')).toContainText('Recording');
+  await page.waitForTimeout(1500);
+  // Stop, and at once open a file (same task): it waits, the recording's take is what is shown.
+  await page.evaluate(() => {
+    document.getElementById('record-button')!.click();
+    const input = document.getElementById('file-input') as HTMLInputElement;
+    const data = new DataTransfer();
+    data.items.add(new File([new Uint8Array(64)], 'too-soon.wav', { type: 'audio/wav' }));
+    input.files = data.files;
+    input.dispatchEvent(new Event('change', { bubbles: true }));
+  });
+  await expect(page.locator('#status')).toContainText('Finishing the recording');
+  await expect(page.locator('#clip-info')).toContainText('Recording', { timeout: 60_000 });
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready');
+  await expect(page.locator('#play-button')).toBeEnabled();
+  await expect(page.locator('#play-button')).toHaveText('Play');
+  await page.locator('#play-button').click();
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+});

@@ -36,5 +36,13 @@ test('the timeline shows the lip gap, the truth and the heard phones, and its pl
   await page.locator('#scrub').fill('60');
   const later = await columns(page);
   expect(later.whiteColumn, 'the playhead moved right').toBeGreaterThan(start.whiteColumn + 20);
+  // The window resized (paused at frame 60): the playhead stays at the frame, at its place on the new width.
+  const atFrame60 = later.whiteColumn / (await page.evaluate(() => (document.getElementById('timeline') as HTMLCanvasElement).width));
+  const wide = await page.evaluate(() => (document.getElementById('timeline') as HTMLCanvasElement).width);
+  await page.setViewportSize({ width: 700, height: 760 });
+  await expect.poll(async () => (await page.evaluate(() => (document.getElementById('timeline') as HTMLCanvasElement).width))).toBeLessThan(wide);
+  const resized = await columns(page);
+  const width = await page.evaluate(() => (document.getElementById('timeline') as HTMLCanvasElement).width);
+  expect(resized.whiteColumn / width, 'the playhead after a resize').toBeCloseTo(atFrame60, 2);
   await test.info().attach('timeline.png', { body: await page.locator('#timeline').screenshot(), contentType: 'image/png' });
 });

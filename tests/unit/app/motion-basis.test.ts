@@ -14,7 +14,7 @@ function motion(frames: number, points: number, rank: number, noise: number): Fl
   return D;
 }
 
-function reconstructionError(D: Float32Array, frames: number, dims: number, m: ReturnType<typeof motionBasis>): number {
+function reconstructionError(D: Float32Array, frames: number, dims: number, m: Awaited<ReturnType<typeof motionBasis>>): number {
   let worst = 0;
   for (let f = 0; f < frames; f++)
     for (let i = 0; i < dims; i += 3) {
@@ -29,10 +29,10 @@ function reconstructionError(D: Float32Array, frames: number, dims: number, m: R
 }
 
 describe('motion components for the compact .glb', () => {
-  it('recovers a motion of rank <= K exactly, and reports its error honestly when the rank is higher', () => {
+  it('recovers a motion of rank <= K exactly, and reports its error honestly when the rank is higher', async () => {
     const frames = 500, points = 60, dims = points * 3;
     const low = motion(frames, points, 6, 0);
-    const m = motionBasis(low, frames, dims, 8);
+    const m = await motionBasis(low, frames, dims, 8);
     expect(m.components).toBe(8);
     expect(m.maxError).toBeLessThan(1e-4);
     expect(reconstructionError(low, frames, dims, m)).toBeLessThan(1e-4);
@@ -49,22 +49,36 @@ describe('motion components for the compact .glb', () => {
     for (let k = 1; k < 6; k++) expect(power(k)).toBeLessThanOrEqual(power(k - 1) * (1 + 1e-6));
 
     const high = motion(frames, points, 14, 0.01);
-    const h = motionBasis(high, frames, dims, 8);
+    const h = await motionBasis(high, frames, dims, 8);
     const actual = reconstructionError(high, frames, dims, h);
     expect(h.maxError).toBeGreaterThan(1e-3);
     expect(h.maxError).toBeCloseTo(actual, 4);
     // More components, less error.
-    expect(motionBasis(high, frames, dims, 14).maxError).toBeLessThan(h.maxError);
+    expect((await motionBasis(high, frames, dims, 14)).maxError).toBeLessThan(h.maxError);
   });
 
-  it('handles fewer frames than components and a still face', () => {
+  it('handles fewer frames than components and a still face', async () => {
     const dims = 30;
     const two = motion(2, 10, 3, 0);
-    expect(motionBasis(two, 2, dims, 8).maxError).toBeLessThan(1e-5);
+    expect((await motionBasis(two, 2, dims, 8)).maxError).toBeLessThan(1e-5);
     const still = new Float32Array(100 * dims).fill(0.25);
-    const s = motionBasis(still, 100, dims, 8);
+    const s = await motionBasis(still, 100, dims, 8);
     expect(s.maxError).toBeLessThan(1e-6);
     expect(s.mean.every((v) => Math.abs(v - 0.25) < 1e-7)).toBe(true);
-    expect(() => motionBasis(still, 99, dims, 8)).toThrow(/not 99 x 30/);
+    await expect(motionBasis(still, 99, dims, 8)).rejects.toThrow(/not 99 x 30/);
+  });
+
+  it('finds the directions on a spread of the frames, and projects every frame on them (a long clip)', async () => {
+    const frames = 3000, points = 40, dims = points * 3;
+    const low = motion(frames, points, 6, 0);
+    const seen: number[] = [];
+    const m = await motionBasis(low, frames, dims, 8, { fitFrames: 200, onProgress: (d) => seen.push(d) });
+    expect(m.maxError, 'rank 6 from 200 of 3,000 frames').toBeLessThan(1e-4);
+    expect(reconstructionError(low, frames, dims, m)).toBeLessThan(1e-4);
+    expect(m.coefficients).toHaveLength(frames * 8);
+    expect(seen.at(-1)).toBe(1);
+    expect(seen.every((d, i) => i === 0 || d >= seen[i - 1])).toBe(true);
+    // Aborted: it stops (at its next yield) with the signal's reason.
+    await expect(motionBasis(low, frames, dims, 8, { signal: AbortSignal.abort() })).rejects.toThrow();
   });
 });
