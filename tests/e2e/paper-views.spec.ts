@@ -125,7 +125,8 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.info.duration).toBeCloseTo((frames - 1) / FPS, 3);
   expect(glb.bytes).toBeLessThan(2e6); // per-frame targets would be ~100 MB
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
-  // The page says what it did.
+  // The page says what it did (after a progress it shows while the page stays live: seconds of work, more on a busy machine).
   await page.locator('#export-glb').click();
-  await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/);
+  await expect(page.locator('#status')).toContainText(/Preparing the \.glb: .*%/);
+  await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/, { timeout: 90_000 });
 });

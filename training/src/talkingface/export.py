@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import io
 import json
+import shutil
 import sys
 import warnings
 from pathlib import Path
@@ -37,6 +38,7 @@ from .model.lip_closure import LipClosure
 from .paths import MODELS_DIR
 from .phones import CONTENT_CLASSES
 from .safetensors import sha256, write_safetensors
+from .cli import read_checkpoint
 from .template import Template, load_template
 
 MANIFEST_FORMAT = "talking-face-model"
@@ -166,11 +168,28 @@ def check_out_template(out: Path, template: Template) -> None:
                          "export to another folder, or put the model's template there")
 
 
+def copy_template(source: Path | None, out: Path) -> str | None:
+    """The browser reads the face from OUT/template/ (the manifest's template.path): where it is not there yet, the
+    template's own files go there (its template.json with its template.bin, and a NOTICE beside them). Says what it
+    did, or what is missing; None where OUT already has it."""
+    there = out / "template" / "template.json"
+    if there.exists():
+        return None
+    if source is None or source.suffix != ".json" or not source.with_suffix(".bin").exists():
+        return (f"note: {there} is missing, and the browser loads the face from there: put the template's template.json "
+                "and template.bin there (npm run import-template makes them from a mesh; docs/templates.md)")
+    there.parent.mkdir(parents=True, exist_ok=True)
+    for f in (source, source.with_suffix(".bin"), source.parent / "NOTICE"):
+        if f.exists():
+            shutil.copyfile(f, there.parent / f.name)
+    return f"copied the face template ({source.parent}) to {there.parent}"
+
+
 def export(checkpoint: Path, out: Path, template: Template | None = None) -> dict:
     """Write the browser's files for `checkpoint` into `out`; `template` defaults to the one the checkpoint names."""
     from .train.train import checkpoint_template, load_checkpoint
     if template is None:
-        template = checkpoint_template(torch.load(checkpoint, map_location="cpu", weights_only=False))
+        template = checkpoint_template(read_checkpoint(checkpoint))
     check_out_template(out, template)
     model, ck = load_checkpoint(checkpoint, template)
     model.eval()
@@ -279,9 +298,14 @@ def main(argv=None) -> int:
         print(f"error: checkpoint {args.checkpoint} does not exist (train one: python -m talkingface.train.train)", file=sys.stderr)
         return 2
     m = export(args.checkpoint, args.out, load_template(args.template, args.masks) if args.template else None)
+    named = args.template or Path(torch.load(args.checkpoint, map_location="cpu", weights_only=False).get("template_path", ""))
+    if said := copy_template(named if str(named) else None, args.out):
+        print(said, file=sys.stderr)
     print(f"exported {m['model']['name']} ({m['model']['parameters']:,} parameters): runtime files {m['runtime_bytes'] / 1e6:.2f} MB -> {args.out}")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -72,12 +72,19 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, default=Path("models/samples"))
     ap.add_argument("--count", type=int, default=DEFAULT_COUNT)
     args = ap.parse_args(argv)
+    if args.count <= 0:
+        ap.error(f"--count must be above 0, not {args.count}")
     ds = open_dataset(args.corpus)
     if ds.layout != "corpus":
         raise SystemExit("samples come from our corpus (it has the alignments with text and voice)")
     args.out.mkdir(parents=True, exist_ok=True)
-    for old in list(args.out.glob("*.wav")) + list(args.out.glob("*.gt.bin")):
-        old.unlink()
+    # The samples written before (listed in their index.json) are replaced; no other file in OUT is touched.
+    before = args.out / "index.json"
+    if before.exists():
+        for c in json.loads(before.read_text()).get("clips", []):
+            for field in ("audio", "ground_truth"):
+                if c.get(field) and "/" not in c[field]:
+                    (args.out / c[field]).unlink(missing_ok=True)
     clips = [write_sample(ds, key, args.out) for key in pick(ds, args.count)]
     for c in clips:
         for field in ("audio", "ground_truth"):
@@ -92,4 +99,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

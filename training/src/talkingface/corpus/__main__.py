@@ -74,9 +74,16 @@ def cmd_setup(args) -> int:
 
 def cmd_build(args) -> int:
     cfg = replace(PRESETS[args.preset], seed=args.seed)
+    bad = ([f"--workers {args.workers} (one or more)"] if args.workers < 1 else []) \
+        + ([f"--sentences {args.sentences} (one or more)"] if args.sentences is not None and args.sentences < 1 else []) \
+        + ([f"--subjects {' '.join(map(str, args.subjects))} (one or more in each split: training, val and test)"]
+           if args.subjects and min(args.subjects) < 1 else [])
+    if bad:
+        print(f"error: {'; '.join(bad)}", file=sys.stderr)
+        return 2
     if args.subjects:
         cfg = replace(cfg, subjects=tuple(args.subjects))
-    if args.sentences:
+    if args.sentences is not None:
         cfg = replace(cfg, sentences_per_subject=args.sentences)
     for tool in ("festival", "flite", "espeak-ng", "sox"):
         if shutil.which(tool) is None:
@@ -141,4 +148,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -91,21 +91,27 @@ class FaceDataset:
             audio, sr = read_wav(self.root / "wav" / f"{key}.wav")
         except WavError as e:  # the dataset's error, naming the clip; the WAV reader's reason kept
             raise DatasetError(f"clip {key}: {e}") from e
-        verts = np.load(self.root / "vertices_npy" / f"{key}.npy")[:: self._frame_step]
+        verts = np.load(self._file("vertices_npy", key, ".npy"))[:: self._frame_step]
         n = self.template.num_vertices
         if verts.ndim != 2 or verts.shape[1] != n * 3:
             raise DatasetError(f"{key}: vertices have shape {verts.shape}, expected (frames, {n * 3}) for template {self.template.id}")
         clip = Clip(key, subject, audio, sr, self.fps, verts.reshape(-1, n, 3).astype(np.float32),
                     self.subject_templates[subject].reshape(n, 3).astype(np.float32))
-        pose_path = self.root / "poses_npy" / f"{key}.npy"
-        if pose_path.exists():
-            clip.pose = np.load(pose_path).astype(np.float32)
-        align_path = self.root / "alignments" / f"{key}.json"
-        if align_path.exists():
-            a = json.loads(align_path.read_text())
+        # Poses and alignments are optional for a dataset (VOCASET has neither), not for a clip of one that has them:
+        # a clip without would be measured as a still head and silence, silently.
+        if (self.root / "poses_npy").is_dir():
+            clip.pose = np.load(self._file("poses_npy", key, ".npy")).astype(np.float32)
+        if (self.root / "alignments").is_dir():
+            a = json.loads(self._file("alignments", key, ".json").read_text())
             clip.phones = [tuple(p) for p in a["phones"]]
             clip.meta = {k: v for k, v in a.items() if k != "phones"}
         return clip
+
+    def _file(self, folder: str, key: str, suffix: str) -> Path:
+        path = self.root / folder / f"{key}{suffix}"
+        if not path.is_file():
+            raise DatasetError(f"clip {key}: missing {folder}/{path.name} in {self.root}")
+        return path
 
 
 def open_dataset(root: str | Path, template: str | Path | None = None, masks: str | Path | None = None) -> FaceDataset:

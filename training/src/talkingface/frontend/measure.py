@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..data.datasets import open_dataset
+from ..cli import dataset_of, dataset_options
 from ..features import AudioConfig, warp_mel
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
@@ -128,6 +128,7 @@ def main(argv=None) -> int:
                     help="hear each clip through one of --warps, chosen by the posteriors' certainty (entropy) or against "
                          "the alignment (oracle: a bound), instead of averaging them")
     ap.add_argument("--out", type=Path, help="also write the figures here (JSON)")
+    dataset_options(ap)
     args = ap.parse_args(argv)
     args.split = [s for s in args.split.split(",") if s]
     try:
@@ -138,7 +139,7 @@ def main(argv=None) -> int:
         ap.error(f"--warps: factors between 0.5 and 2, not {args.warps}")
     if args.choose_warp and len(warps) < 2:
         ap.error("--choose-warp: give two or more --warps to choose from")
-    ds = open_dataset(args.corpus)
+    ds = dataset_of(args)
     audio = AudioConfig()
     clips = {s: [prepare(ds, k, audio) for k in ds.keys(s)] for s in args.split}
     results = {}
@@ -174,4 +175,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

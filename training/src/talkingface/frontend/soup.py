@@ -22,6 +22,7 @@ import sys
 
 import torch
 
+from ..cli import read_checkpoint
 from ..model.encoders import ContentEncoder
 from ..train.train import load_frontend
 
@@ -80,9 +81,7 @@ def main(argv=None) -> int:
         ap.error(str(e))
     made = {"base": args.base, "tuned": args.tuned, "alpha": args.alpha}
     if args.face:
-        payload = torch.load(args.face, map_location="cpu", weights_only=False)
-        if "model" not in payload:
-            ap.error(f"--face: {args.face} is not a face checkpoint")
+        payload = read_checkpoint(args.face)
         model = payload["model"]
         face = with_look_ahead_of({"content": {k[len("content."):]: v for k, v in model.items() if k.startswith("content.")},
                                    "model_config": payload["model_config"]}, tuned)
@@ -97,8 +96,13 @@ def main(argv=None) -> int:
     torch.save(payload, args.out)
     into = f" in {args.face}" if args.face else ""
     print(f"front-end {1 - args.alpha:g} x {args.base} + {args.alpha:g} x {args.tuned}{into} -> {args.out}")
+    if args.face and "lip_closure" in payload:  # calibrated on what the old front-end heard
+        print(f"its lip closure is still {args.face}'s: calibrate it for this front-end (scripts/py -m talkingface.model.lip_closure "
+              f"--corpus ... --checkpoint {args.out}) before exporting it", file=sys.stderr)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -25,6 +25,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
+from ..cli import check_run_folder, require_positive
 from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
@@ -193,6 +194,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if not 0 <= args.timbre <= 1:
         ap.error(f"--timbre: a fraction of the crops, between 0 and 1, not {args.timbre}")
+    require_positive(ap, args, "minutes", "steps", "batch", "threads", "eval_every")
+    check_run_folder(ap, args.out, args.resume, "checkpoint.pt", "frontend.pt")
     if args.device.startswith("cuda") and not torch.cuda.is_available():
         raise SystemExit(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
     torch.set_num_threads(args.threads)
@@ -263,47 +266,52 @@ def main(argv=None) -> int:
 
     start = time.time() - trained
     losses = []
-    progress = (lambda: step / args.steps) if args.steps else (lambda: trained / (60 * args.minutes))
-    while True:
-        trained = time.time() - start
-        if progress() >= 1:
-            break
-        for g in opt.param_groups:  # cosine over the budget
-            g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(progress(), 1.0))))
-        if args.consistency:
-            crop, lab = bank.crops(rng, args.batch, cfg.content_stride)
-            views = [timbre(warp(crop, warp_factors(rng, args.batch, crop.device)), rng, args.timbre) for _ in range(2)]
-            mel = torch.cat(views)
-            logits = forward_augmented(enc, mel, rng)
-            lab = torch.cat([lab, lab])
-        else:
-            mel, lab = bank.batch(rng, args.batch, cfg.content_stride)
-            mel = timbre(mel, rng, args.timbre)
-            logits = forward_augmented(enc, mel, rng)
-        k = min(logits.shape[1], lab.shape[1])
-        loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=PAD_LABEL)
-        if args.consistency:
-            loss = loss + args.consistency * view_disagreement(logits[:, :k], lab[:, :k] != PAD_LABEL)
-        if teacher is not None:
-            with torch.no_grad():
-                heard_by_teacher = teacher(mel)
-            loss = loss + args.distill * distillation(logits[:, :k], heard_by_teacher, lab[:, :k] != PAD_LABEL)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
-        opt.step()
-        step += 1
-        losses.append(loss.item())
-        if step % args.eval_every == 0:
-            ev = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
-            history.append({"step": step, "minutes": trained / 60, "loss": float(np.mean(losses[-100:])),
-                            **{f"{s}_{m}": ev[s][m] for s in ev for m in ("frame_accuracy", "bilabial_segments_heard")}})
-            log(f"step {step}  loss {history[-1]['loss']:.3f}  val acc {100 * ev['val']['frame_accuracy']:.1f}%  "
-                f"test acc {100 * ev['test']['frame_accuracy']:.1f}%  /p b m/ heard {100 * ev['test']['bilabial_segments_heard']:.1f}%  "
-                f"{step / max(trained, 1e-9):.2f} steps/s  ~{trained * (1 / max(progress(), 1e-9) - 1) / 60:.1f} min left")
-            save(ck_path)
-            if args.snapshots:
-                save(args.out / f"frontend-step{step}.pt", final=True)
+    progress = (lambda: step / args.steps) if args.steps is not None else (lambda: trained / (60 * args.minutes))
+    try:
+        while True:
+            trained = time.time() - start
+            if progress() >= 1:
+                break
+            for g in opt.param_groups:  # cosine over the budget
+                g["lr"] = args.lr * (0.03 + 0.97 * 0.5 * (1 + np.cos(np.pi * min(progress(), 1.0))))
+            if args.consistency:
+                crop, lab = bank.crops(rng, args.batch, cfg.content_stride)
+                views = [timbre(warp(crop, warp_factors(rng, args.batch, crop.device)), rng, args.timbre) for _ in range(2)]
+                mel = torch.cat(views)
+                logits = forward_augmented(enc, mel, rng)
+                lab = torch.cat([lab, lab])
+            else:
+                mel, lab = bank.batch(rng, args.batch, cfg.content_stride)
+                mel = timbre(mel, rng, args.timbre)
+                logits = forward_augmented(enc, mel, rng)
+            k = min(logits.shape[1], lab.shape[1])
+            loss = F.cross_entropy(logits[:, :k].flatten(0, 1), lab[:, :k].flatten(), weight=class_weight, ignore_index=PAD_LABEL)
+            if args.consistency:
+                loss = loss + args.consistency * view_disagreement(logits[:, :k], lab[:, :k] != PAD_LABEL)
+            if teacher is not None:
+                with torch.no_grad():
+                    heard_by_teacher = teacher(mel)
+                loss = loss + args.distill * distillation(logits[:, :k], heard_by_teacher, lab[:, :k] != PAD_LABEL)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(enc.parameters(), 1.0)
+            opt.step()
+            step += 1
+            losses.append(loss.item())
+            if step % args.eval_every == 0:
+                ev = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
+                history.append({"step": step, "minutes": trained / 60, "loss": float(np.mean(losses[-100:])),
+                                **{f"{s}_{m}": ev[s][m] for s in ev for m in ("frame_accuracy", "bilabial_segments_heard")}})
+                log(f"step {step}  loss {history[-1]['loss']:.3f}  val acc {100 * ev['val']['frame_accuracy']:.1f}%  "
+                    f"test acc {100 * ev['test']['frame_accuracy']:.1f}%  /p b m/ heard {100 * ev['test']['bilabial_segments_heard']:.1f}%  "
+                    f"{step / max(trained, 1e-9):.2f} steps/s  ~{trained * (1 / max(progress(), 1e-9) - 1) / 60:.1f} min left")
+                save(ck_path)
+                if args.snapshots:
+                    save(args.out / f"frontend-step{step}.pt", final=True)
+    except KeyboardInterrupt:  # Ctrl-C: what was trained is kept, and can be continued
+        save(ck_path)
+        log(f"interrupted at step {step}: saved {ck_path}; the same command with --resume continues it")
+        return 130
     final = {s: evaluate(enc, held[s], cfg.content_classes, cfg.content_stride) for s in held}
     save(ck_path)
     save(args.out / "frontend.pt", final=True)
@@ -315,4 +323,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

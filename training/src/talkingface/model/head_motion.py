@@ -262,7 +262,7 @@ def motion_stats(tracks: list[np.ndarray]) -> dict:
 
 def main(argv=None) -> int:
     import torch
-    from ..data.datasets import open_dataset
+    from ..cli import dataset_of, dataset_options, made_from
     from ..train.train import load_checkpoint
     ap = argparse.ArgumentParser(prog="python -m talkingface.model.head_motion", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -275,28 +275,27 @@ def main(argv=None) -> int:
     ap.add_argument("--no-speech", action="store_true", help="no speech read-out: the process alone (the earlier model)")
     ap.add_argument("--per-clip", action="store_true", help="the gain from the spreads' means over all clips (the earlier model), "
                     "not the geometric mean over speakers")
+    dataset_options(ap)
     args = ap.parse_args(argv)
     model, ck = load_checkpoint(args.checkpoint)
     model.eval()
-    ds = open_dataset(args.corpus)
+    ds = dataset_of(args)
 
-    def progress(i, n):
-        if i % 50 == 0 or i == n:
-            print(f"  {i}/{n} clips", file=sys.stderr)
-
+    progress = lambda i, n: (i % 50 == 0 or i == n) and print(f"  {i}/{n} clips", file=sys.stderr)
+    source = made_from(args.checkpoint, args.corpus, text="\n".join(ds.keys("train")))  # what the residuals depend on
     if args.cache and args.cache.exists():
         data = np.load(args.cache)
-        if not ("speakers" in data and "against_mean" in data and bool(data["against_mean"]) == args.against_mean):
-            raise SystemExit(f"{args.cache} holds another run's residuals (the other --against-mean, or an earlier version): "
-                             "delete it or give another --cache")
+        if not ("made_from" in data and str(data["made_from"]) == source and bool(data["against_mean"]) == args.against_mean):
+            raise SystemExit(f"{args.cache} was made from another corpus or checkpoint, with the other --against-mean, or by "
+                             "an earlier version: delete it or give another --cache")
         n = int(data["clips"])
         residuals, feats, speakers = [data[f"r{i}"] for i in range(n)], [data[f"f{i}"] for i in range(n)], data["speakers"].tolist()
-        sources = data["sources"].tolist() if "sources" in data else []  # a cache from before they were kept has none
+        sources = data["sources"].tolist()
     else:
         residuals, feats, speakers, sources = collect(model, ds, "train", progress, args.against_mean)
         if args.cache:
             np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), sources=np.array(sources), against_mean=args.against_mean,
-                     **{f"r{i}": r for i, r in enumerate(residuals)}, **{f"f{i}": f for i, f in enumerate(feats)})
+                     made_from=source, **{f"r{i}": r for i, r in enumerate(residuals)}, **{f"f{i}": f for i, f in enumerate(feats)})
     from ..corpus.clip import neck_pivot
     template_mm = ds.template.vertices.astype(np.float64) * ds.mm_per_unit
     hm = fit(residuals, feats, neck_pivot(template_mm, ds.template), None if args.no_speech else args.ridge,
@@ -326,4 +325,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -182,7 +182,7 @@ def fit(segments, template: Template, lo: float = 2.0, hi: float = 12.0, mouth_g
 
 def main(argv=None) -> int:
     import torch
-    from ..data.datasets import open_dataset
+    from ..cli import dataset_of, dataset_options
     from ..train.train import load_checkpoint
     ap = argparse.ArgumentParser(prog="python -m talkingface.model.lip_closure", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -192,9 +192,10 @@ def main(argv=None) -> int:
     ap.add_argument("--split", default="val", help="the split to calibrate on (its voices unheard in training)")
     ap.add_argument("--mouth-gain", type=float, help="scale the mouth's amplitude (the lips' tissue and the jaw) by this "
                     "before closing (default: the checkpoint's, else 1; chosen on val: docs/results/README.md)")
+    dataset_options(ap)
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
-    ds = open_dataset(args.corpus)
+    ds = dataset_of(args)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
     segs = heard_bilabials(model, ds, args.split, lambda i, n: i % 20 == 0 and print(f"  {i}/{n} clips", file=sys.stderr))
@@ -214,4 +215,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -35,16 +35,22 @@ def run_row(corpus: str, row: str, seed: int, steps: int, runs: Path, extra: lis
     features, decoder = row.split("+")
     out = runs / f"{row.replace('+', '-')}-s{seed}"
     final = out / "final.pt"
-    if not (final.exists() and torch.load(final, weights_only=False)["step"] == steps):
-        train.main(["--corpus", corpus, "--out", str(out), "--features", features, "--decoder", decoder,
-                    "--steps", str(steps), "--seed", str(seed), *extra])
+    argv = ["--corpus", corpus, "--out", str(out), "--features", features, "--decoder", decoder,
+            "--steps", str(steps), "--seed", str(seed), *extra]
+    wanted = vars(train.parser().parse_args(argv))
+    same = ("corpus", "features", "decoder", "steps", "seed", "batch_clips", "frames", "silence")
+    done = torch.load(final, weights_only=False) if final.exists() else None
+    if not (done and all(done["args"].get(k) == wanted[k] for k in same)):
+        for stale in (out / "checkpoint.pt", final, out / "ablation_eval.json"):  # another budget or corpus: trained again
+            stale.unlink(missing_ok=True)
+        train.main(argv)
     cached = out / "ablation_eval.json"
-    if cached.exists() and cached.stat().st_mtime >= final.stat().st_mtime:
-        return json.loads(cached.read_text())  # evaluation is deterministic: reuse it for this checkpoint
+    if cached.exists() and cached.stat().st_mtime >= final.stat().st_mtime and json.loads(cached.read_text()).get("corpus") == corpus:
+        return json.loads(cached.read_text())  # evaluation is deterministic: reuse it for this checkpoint and corpus
     ds = open_dataset(corpus)
     model, ck = train.load_checkpoint(final, ds.template)
     res = evaluate(model, ds, "test")
-    row = {"seed": seed, "minutes": ck["trained_seconds"] / 60, "all": res["all"], "human": res["human"]}
+    row = {"seed": seed, "corpus": corpus, "minutes": ck["trained_seconds"] / 60, "all": res["all"], "human": res["human"]}
     cached.write_text(json.dumps(row))
     return row
 
@@ -162,4 +168,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -17,7 +17,7 @@ import sys
 import numpy as np
 import torch
 
-from ..data.datasets import open_dataset
+from ..cli import dataset_of, dataset_options
 from ..phones import BILABIALS, PHONES
 from . import articulation as art
 from ..model import lip_closure as lc
@@ -80,9 +80,10 @@ def main(argv=None) -> int:
     ap.add_argument("--split", default="val")
     ap.add_argument("--raw", action="store_true", help="the model's offsets as they are, without the checkpoint's lip closure")
     ap.add_argument("--reference-gap", type=float, help="retarget the closure with this reference gap (mm) instead of the checkpoint's")
+    dataset_options(ap)
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
-    ds = open_dataset(args.corpus)
+    ds = dataset_of(args)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
     reference, gain = (None, 1.0) if args.raw else lc.calibration(ck)  # with the gain it was calibrated with
@@ -92,4 +93,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

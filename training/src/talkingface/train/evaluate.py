@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..data.datasets import open_dataset
+from ..cli import dataset_of, dataset_options
 from ..features import frame_to_mel_index, log_mel
 from ..geometry.contours import lip_gap
 from ..geometry.pose import apply_pose as apply_pose_np
@@ -169,17 +169,29 @@ def main(argv=None) -> int:
     ap.add_argument("--oracle-phones", action="store_true",
                     help="decode the alignment's phones instead of the content encoder's logits: the face with a front-end that "
                          "hears every phone (a diagnosis of what limits articulation, not a result)")
+    dataset_options(ap)
     args = ap.parse_args(argv)
-    ds = open_dataset(args.corpus)
+    if args.head_draws < 1:
+        ap.error(f"--head-draws: one or more, not {args.head_draws}")
+    if args.out:  # checked before the work (minutes of it), not after
+        out_dir = Path(args.out).parent
+        if out_dir.exists() and not out_dir.is_dir():
+            ap.error(f"--out {args.out}: {out_dir} is a file, not a folder")
+    if not Path(args.checkpoint).is_file():
+        ap.error(f"--checkpoint {args.checkpoint} does not exist")
+    ds = dataset_of(args)
     model, ck = load_checkpoint(Path(args.checkpoint), ds.template)
     t0 = time.time()
     heads: list = []
     head = hmodel.HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck and not args.mean_pose else None
     closure, gain = (None, 1.0) if args.raw_lips else lc.calibration(ck)
-    if args.head_draws < 1:
-        ap.error(f"--head-draws: one or more, not {args.head_draws}")
-    res = evaluate(model, ds, args.split, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure, mouth_gain=gain,
-                   oracle_phones=args.oracle_phones, head_draws=args.head_draws)
+
+    def progress(i: int, n: int) -> None:
+        if i % 10 == 0 or i == n:
+            print(f"  {i}/{n} clips ({time.time() - t0:.0f} s)", file=sys.stderr, flush=True)
+
+    res = evaluate(model, ds, args.split, progress=progress, head_rows=heads, head=head, seed=args.head_seed, lip_closure=closure,
+                   mouth_gain=gain, oracle_phones=args.oracle_phones, head_draws=args.head_draws)
     res["oracle_phones"], res["split"] = args.oracle_phones, args.split
     res["lip_closure"] = {"reference_gap_mm": closure, "mouth_gain": gain} if closure is not None else None
     res["checkpoint"] = {"path": args.checkpoint, "step": ck["step"], "minutes": ck["trained_seconds"] / 60,
@@ -257,4 +269,6 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

@@ -22,7 +22,7 @@ from statistics import NormalDist
 import numpy as np
 import torch
 
-from ..data.datasets import open_dataset
+from ..cli import dataset_of, dataset_options
 from ..model import lip_closure as lc
 from ..phones import BILABIALS
 from . import articulation as art
@@ -86,8 +86,9 @@ def main(argv=None) -> int:
     ap.add_argument("--split", default="val", choices=("train", "val", "test"),
                     help="the split both are measured on (default val, which decides)")
     ap.add_argument("--out", type=Path, help="also write the figures as JSON here")
+    dataset_options(ap)
     args = ap.parse_args(argv)
-    ds = open_dataset(args.corpus)
+    ds = dataset_of(args)
     if not ds.keys(args.split):
         ap.error(f"--split {args.split}: {args.corpus} has no clips in it")
     torch.set_num_threads(1)
@@ -109,4 +110,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)

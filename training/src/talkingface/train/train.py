@@ -6,7 +6,8 @@
 
 Checkpoints (OUT/checkpoint.pt, and OUT/final.pt at the end) carry the model and audio configs,
 the training arguments and the step, so `--resume` continues exactly and evaluation/export need
-nothing else. Nothing in OUT is deleted.
+nothing else. An OUT that already holds a run is refused unless `--resume` continues it (nothing there is
+overwritten by a new run); Ctrl-C saves OUT/checkpoint.pt first, so `--resume` picks up where it stopped.
 """
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ from ..model import lip_closure as lc
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from ..paths import REPO_ROOT, TEMPLATE_DIR
+from ..cli import check_run_folder, read_checkpoint, require_positive
 from ..template import Template, TemplateFormatError, load_template
 from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
 from .losses import LossWeights, total_loss
@@ -51,7 +53,7 @@ def checkpoint_template(ck: dict) -> Template:
 
 def load_checkpoint(path: Path, template: Template | None = None):
     """-> (model, checkpoint dict). `template` defaults to the one the checkpoint names (checkpoint_template)."""
-    ck = torch.load(path, map_location="cpu", weights_only=False)
+    ck = read_checkpoint(path)
     cfg = ModelConfig.from_dict(ck["model_config"])
     audio = AudioConfig(**ck["audio_config"])
     if template is None:
@@ -63,7 +65,7 @@ def load_checkpoint(path: Path, template: Template | None = None):
     return model, ck
 
 
-def parse_args(argv=None) -> argparse.Namespace:
+def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="python -m talkingface.train.train", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--corpus", required=True, help="dataset folder (our corpus, processed VOCASET or Multiface)")
@@ -108,9 +110,16 @@ def parse_args(argv=None) -> argparse.Namespace:
                     help=f"content frames (20 ms each) of the window after the animation frame (default "
                          f"{ModelConfig.window_future}); with --init from a model of another, the window moves and the "
                          "training re-learns it. Look-ahead in all: this, the front-end's and half a Mel frame (export.py)")
+    return ap
+
+
+def parse_args(argv=None) -> argparse.Namespace:
+    ap = parser()
     args = ap.parse_args(argv)
     if (args.minutes is None) == (args.steps is None):
         ap.error("give exactly one of --minutes and --steps")
+    require_positive(ap, args, "minutes", "steps", "batch_clips", "frames", "checkpoint_every", "threads")
+    check_run_folder(ap, args.out, args.resume, "checkpoint.pt", "final.pt")
     if args.content_warp and (not args.frontend or args.tune_frontend):
         ap.error("--content-warp needs a frozen --frontend (it degrades what a trained front-end hears)")
     if args.content_warp and not 0.5 < args.content_warp[0] <= args.content_warp[1] < 2:
@@ -138,7 +147,7 @@ def content_warp(mel: torch.Tensor, rng: np.random.Generator, lo: float, hi: flo
 def load_frontend(path: str) -> dict:
     """A front-end file (frontend.train's frontend.pt), or the content encoder of a face checkpoint in the same form
     (so a model can be fine-tuned on the shipped front-end after runs/, which holds the front-end's own run, is gone)."""
-    ck = torch.load(path, map_location="cpu", weights_only=False)
+    ck = read_checkpoint(path, kind="any")
     if "content" in ck:
         return ck
     if "model" not in ck:
@@ -185,7 +194,7 @@ def main(argv=None) -> int:
         norm.mean.copy_(torch.from_numpy(mean))
         norm.std.copy_(torch.from_numpy(std))
     if args.init:
-        init = torch.load(args.init, map_location="cpu", weights_only=False)
+        init = read_checkpoint(args.init)
         init_cfg = ModelConfig.from_dict(init["model_config"]).to_dict()
         gains_shape = not init_cfg["template_input"] and cfg.template_input  # a model without the shape input gains it, at zero
         # A --frontend replaces the content encoder, so the initial model's may differ from it (e.g. a look-ahead block).
@@ -211,8 +220,6 @@ def main(argv=None) -> int:
     step, trained_seconds = 0, 0.0
     ck_path = out / "checkpoint.pt"
     if args.resume:
-        if not ck_path.exists():
-            raise SystemExit(f"--resume: {ck_path} does not exist")
         ck = torch.load(ck_path, map_location="cpu", weights_only=False)
         if ck["model_config"] != cfg.to_dict():
             raise SystemExit(f"--resume: {ck_path} is a {ck['model_config']} model, not {cfg.to_dict()}")
@@ -253,39 +260,44 @@ def main(argv=None) -> int:
     history = []
     start = time.time() - trained_seconds
     model.train()
-    while True:
-        trained_seconds = time.time() - start
-        done = (budget_steps is not None and step >= budget_steps) or (args.minutes is not None and trained_seconds >= 60 * args.minutes)
-        if distributed:  # every process stops at the same step
-            flag = torch.tensor([1.0 if done else 0.0])
-            dist.all_reduce(flag, op=dist.ReduceOp.MAX)
-            done = flag.item() > 0
-        if done:
-            break
-        # Cosine decay over the budget (steps, or time when the budget is minutes).
-        progress = step / budget_steps if budget_steps else trained_seconds / (60 * args.minutes)
-        for g in opt.param_groups:
-            g["lr"] = g.get("scale", 1.0) * args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
-        b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
-        heard = content_warp(b.mel, rng, *args.content_warp) if args.content_warp else None
-        out_ = net(b.mel, b.mel_index, b.template, content_mel=heard)
-        if args.lip_closure:
-            out_ = retarget(out_, b.template)
-        loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights, pairs)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
-        opt.step()
-        step += 1
-        history.append(parts)
-        if step % 20 == 0 and rank == 0:
-            avg = {k: np.mean([h[k] for h in history[-20:]]) for k in parts}
-            rate = step / max(time.time() - start, 1e-9)
-            left = ((budget_steps - step) / rate) if budget_steps else (60 * args.minutes - trained_seconds)
-            log(f"step {step:6d}  rec {avg['rec']:.3f} mm  unposed {avg['rec_unposed']:.3f} mm  lips {avg['rec_lips']:.3f} mm  gap {avg['gap']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
-                f"phones {avg['content']:.3f}  lr {opt.param_groups[0]['lr']:.1e}  {rate:.2f} steps/s  ~{left / 60:.1f} min left")
-        if step % args.checkpoint_every == 0:
-            save(ck_path)
+    try:
+        while True:
+            trained_seconds = time.time() - start
+            done = (budget_steps is not None and step >= budget_steps) or (args.minutes is not None and trained_seconds >= 60 * args.minutes)
+            if distributed:  # every process stops at the same step
+                flag = torch.tensor([1.0 if done else 0.0])
+                dist.all_reduce(flag, op=dist.ReduceOp.MAX)
+                done = flag.item() > 0
+            if done:
+                break
+            # Cosine decay over the budget (steps, or time when the budget is minutes).
+            progress = step / budget_steps if budget_steps else trained_seconds / (60 * args.minutes)
+            for g in opt.param_groups:
+                g["lr"] = g.get("scale", 1.0) * args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
+            b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
+            heard = content_warp(b.mel, rng, *args.content_warp) if args.content_warp else None
+            out_ = net(b.mel, b.mel_index, b.template, content_mel=heard)
+            if args.lip_closure:
+                out_ = retarget(out_, b.template)
+            loss, parts = total_loss(out_, b.vertices, b.pose, b.template, b.content_labels, eye, lips, weights, pairs)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+            opt.step()
+            step += 1
+            history.append(parts)
+            if step % 20 == 0 and rank == 0:
+                avg = {k: np.mean([h[k] for h in history[-20:]]) for k in parts}
+                rate = step / max(time.time() - start, 1e-9)
+                left = ((budget_steps - step) / rate) if budget_steps else (60 * args.minutes - trained_seconds)
+                log(f"step {step:6d}  rec {avg['rec']:.3f} mm  unposed {avg['rec_unposed']:.3f} mm  lips {avg['rec_lips']:.3f} mm  gap {avg['gap']:.3f} mm  vel {avg['vel']:.4f}  pose {avg['pose']:.2f}  eye {avg['eye']:.3f}  "
+                    f"phones {avg['content']:.3f}  lr {opt.param_groups[0]['lr']:.1e}  {rate:.2f} steps/s  ~{left / 60:.1f} min left")
+            if step % args.checkpoint_every == 0:
+                save(ck_path)
+    except KeyboardInterrupt:  # Ctrl-C: what was trained is kept, and can be continued
+        save(ck_path)
+        log(f"interrupted at step {step}: saved {ck_path}; the same command with --resume continues it")
+        return 130
     save(ck_path)
     save(out / "final.pt")
     if rank == 0:
@@ -300,4 +312,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from talkingface.cli import run_cli  # the usual mistakes in one line
+
+    run_cli(main)
