@@ -167,3 +167,12 @@ def test_dataset_of_opens_the_corpus_with_the_template_named(corpus):
     from talkingface.cli import dataset_of
     ds = dataset_of(argparse.Namespace(corpus=str(corpus.root), template=str(corpus.root / "template" / "template.json"), masks=None))
     assert ds.template.id == corpus.template.id and ds.keys("test") == corpus.keys("test")
+
+
+def test_a_file_that_is_not_a_speech_bank_is_said_so(tmp_path):
+    from talkingface.data.datasets import DatasetError
+    from talkingface.frontend.bank import unpack
+    other = tmp_path / "other.npz"
+    np.savez(other, something=np.zeros(3))
+    with pytest.raises(DatasetError, match="is not a packed speech bank"):
+        unpack(other)

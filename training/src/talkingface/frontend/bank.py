@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..data.datasets import DatasetError
+
 CROP = 300           # Mel frames per crop (3 s)
 WARP = (0.9, 1.1)    # frequency-axis warp factors (vocal-tract length perturbation)
 TIME_MASKS, TIME_MASK_MAX = 2, 12   # SpecAugment: masks per crop and their largest width (Mel frames)
@@ -159,8 +161,11 @@ def pack(out: Path, train: list[tuple[np.ndarray, np.ndarray]], held: dict[str, 
 
 def unpack(path: Path) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
     """pack's file -> {"train": clips, "val": clips, "test": clips}, the Mel back in float32."""
-    z = np.load(path)
-    lo, hi = z["range"]
+    try:
+        z = np.load(path)
+        lo, hi = z["range"]
+    except (ValueError, KeyError, OSError) as e:  # a pickle, another .npz, not numpy's at all
+        raise DatasetError(f"{path} is not a packed speech bank (talkingface.frontend.bank's .npz): {e}") from e
     out = {}
     for name in sorted({k.rsplit("_", 1)[0] for k in z.files if k.endswith("_lengths")}):
         mel, lab = dequantise(z[f"{name}_mel"], lo, hi), z[f"{name}_labels"].astype(np.int64)

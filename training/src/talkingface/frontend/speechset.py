@@ -241,9 +241,9 @@ def build(out: Path, minutes: float, seed: int, workers: int, kokoro_voices: str
     voice beyond two of its voices (plan). `more_share`: the share of the synthetic clips said by RHVoice's and Pico's voices.
     `diphone_share`: the share of the synthetic clips said by festival's and MBROLA's diphone voices (plan).
     `mbrola_share`: the share of the synthetic clips said by MBROLA's voices of other languages (plan)."""
-    out.mkdir(parents=True, exist_ok=True)
     specs = plan(minutes, seed, kokoro_voices, foreign_share, accent_share, extrapolate_share, more_share, diphone_share,
-                 mbrola_share)[:first]
+                 mbrola_share)[:first]  # before the folder: a voice missing leaves nothing behind
+    out.mkdir(parents=True, exist_ok=True)
     done = {json.loads(l)["key"] for l in (out / "index.jsonl").read_text().splitlines()} if (out / "index.jsonl").exists() else set()
     todo = [s for s in specs if s.key not in done]  # a build that was stopped continues where it was
     t0, n = time.time(), 0
