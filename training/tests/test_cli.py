@@ -176,3 +176,13 @@ def test_a_file_that_is_not_a_speech_bank_is_said_so(tmp_path):
     np.savez(other, something=np.zeros(3))
     with pytest.raises(DatasetError, match="is not a packed speech bank"):
         unpack(other)
+
+
+def test_evaluate_says_what_its_figures_are_measured_against_without_alignments_or_poses(corpus, trained_run, tmp_path):
+    copy = tmp_path / "no-alignments"
+    shutil.copytree(corpus.root, copy)
+    shutil.rmtree(copy / "alignments")
+    out = tmp_path / "eval.json"
+    assert evaluate.main(["--corpus", str(copy), "--checkpoint", str(trained_run / "final.pt"), "--out", str(out), "--head-draws", "1"]) == 0
+    assert json.loads(out.read_text())["missing"] == ["phone alignments"]
+    assert "**Note**: the dataset has no phone alignments" in out.with_suffix(".md").read_text()

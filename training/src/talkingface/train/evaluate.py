@@ -108,7 +108,9 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         head_rows.extend(heads)
     head = {"all": hm.summarise_draws(heads), "synthetic": hm.summarise_draws([r for r in heads if r["source"] != "human"]),
             "human": hm.summarise_draws([r for r in heads if r["source"] == "human"])}
-    return {"all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
+    # A dataset without phone alignments (VOCASET) or head poses: what those measures are taken against, said with them.
+    missing = [what for what, folder in (("phone alignments", "alignments"), ("head poses", "poses_npy")) if not (ds.root / folder).is_dir()]
+    return {"missing": missing, "all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
             "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure, mouth_gain),
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
@@ -202,6 +204,8 @@ def main(argv=None) -> int:
     issue_targets = args.split == "test" and not args.oracle_phones  # the issues set them on the test split
     res["targets"] = targets.check(res) if issue_targets else None
     a = res["all"]
+    for line in missing_notes(res):
+        print(f"note: {line}", file=sys.stderr)
     print(f"{ck['model_config']['features']}+{ck['model_config']['decoder']}: E_vl {a['E_vl']:.3f} mm  E_ve {a['E_ve']:.3f} mm  "
           f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
           + (f"  | human E_vl {res['human']['E_vl']:.3f} mm" if res["human"] else ""))
@@ -222,6 +226,14 @@ def main(argv=None) -> int:
     return 0
 
 
+def missing_notes(res: dict) -> list[str]:
+    """What the figures mean where the dataset lacks an input (res["missing"])."""
+    said = {"phone alignments": "the dataset has no phone alignments: the content encoder's and the articulation figures "
+                                "are measured against silence labels, and mean nothing here",
+            "head poses": "the dataset has no head poses: the pose figures are measured against a still head"}
+    return [said[m] for m in res.get("missing", [])]
+
+
 def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
     cfg = ck["model_config"]
     rows = []
@@ -239,6 +251,8 @@ def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
         f"`scripts/py -m talkingface.train.evaluate --corpus {args.corpus} --checkpoint {args.checkpoint} --split {args.split} --out {args.out}"
         f"{' --raw-lips' if getattr(args, 'raw_lips', False) else ''}{' --oracle-phones' if getattr(args, 'oracle_phones', False) else ''}`.",
         "",
+        *[f"**Note**: {line}" for line in missing_notes(res)],
+        *([""] if missing_notes(res) else []),
         *(["**Oracle phones**: the face decodes the alignment's phones (certain, one-hot) instead of what its content encoder",
            "heard: what it would do with a front-end that hears every phone. A diagnosis, not a result; the content encoder's",
            "table below is still its own.", ""] if getattr(args, "oracle_phones", False) else []),
