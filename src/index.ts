@@ -12,7 +12,7 @@ export { LiveSession, type LiveOptions } from './engine/live';
 export { decodeAudio, levels, AudioDecodeError, type DecodedAudio } from './audio/decode';
 export { openMicrophone, AudioCapture, StreamResampler, MicrophoneError, type CaptureOptions } from './audio/capture';
 export { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from './audio/mel';
-export { ModelLoadError } from './model/artefacts';
+export { ModelLoadError, fetchManifest } from './model/artefacts';
 export type { ExecutionProvider } from './encoders/onnx-model';
 export { checkManifest, frameToMelIndex, DEFAULT_MANIFEST_URL, type Manifest } from './model/manifest';
 export { ReferenceDecoder, decoderWeights, type DecoderWeights, type DecodeResult } from './attention/reference';

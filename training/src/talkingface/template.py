@@ -167,7 +167,7 @@ def _load_native(path: Path) -> Template:
 
 def subdivide(t: Template, new_id: str | None = None) -> Template:
     """Midpoint subdivision: every edge gets a vertex, every triangle becomes four. A new vertex joins a
-    region when both ends of its edge are in it. (468 -> 1,788 vertices for the MediaPipe face.)"""
+    region when both ends of its edge are in it. (468 -> 1,790 vertices for the MediaPipe face.)"""
     tri = t.triangles
     edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
     uniq, inverse = np.unique(edges, axis=0, return_inverse=True)
