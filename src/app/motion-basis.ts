@@ -47,8 +47,8 @@ export async function motionBasis(D: Float32Array, frames: number, dims: number,
   // Work in frame-rows: each round reads the fitted frames twice; the end, every frame twice.
   const total = iterations * 2 * fit.length + 2 * frames;
   let done = 0, lastYield = performance.now();
-  const step = async (rows: number) => {
-    done += rows;
+  const step = async () => {
+    done++;
     if (performance.now() - lastYield < YIELD_EVERY_MS) return;
     onProgress?.(done / total);
     await yieldToEventLoop();
@@ -71,7 +71,7 @@ export async function motionBasis(D: Float32Array, frames: number, dims: number,
   for (let it = 0; it < iterations; it++) {
     for (const f of fit) {
       project(D, mean, f, dims, Q, K, P);
-      await step(1);
+      await step();
     }
     // Q <- P^T D_centred (K x dims) over the fitted frames, then orthonormalise
     Q.fill(0);
@@ -83,13 +83,13 @@ export async function motionBasis(D: Float32Array, frames: number, dims: number,
         const q = k * dims;
         for (let i = 0; i < dims; i++) Q[q + i] += p * (D[row + i] - mean[i]);
       }
-      await step(1);
+      await step();
     }
     orthonormalise(Q, K, dims);
   }
   for (let f = 0; f < frames; f++) {
     project(D, mean, f, dims, Q, K, P);
-    await step(1);
+    await step();
   }
   // Order by strength (the variance along each direction).
   const strength = Array.from({ length: K }, (_, k) => {
@@ -116,7 +116,7 @@ export async function motionBasis(D: Float32Array, frames: number, dims: number,
       const e = Math.hypot(D[f * dims + i] - r[i], D[f * dims + i + 1] - r[i + 1], D[f * dims + i + 2] - r[i + 2]);
       if (e > maxError) maxError = e;
     }
-    await step(1);
+    await step();
   }
   onProgress?.(1);
   return { mean, basis, coefficients, components: K, maxError };

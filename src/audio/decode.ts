@@ -63,7 +63,7 @@ export function levels(samples: Float32Array): { peak: number; rms: number; clip
 }
 
 /** Below this peak (-30 dBFS) a clip is quiet: raised for the model (raiseIfQuiet). */
-export const QUIET_PEAK = 0.0316;
+const QUIET_PEAK = 0.0316;
 /** Below this peak a clip is silent (-60 dBFS): left as it is, and said so. */
 export const SILENT_PEAK = 1e-3;
 const RAISED_PEAK = 0.5;

@@ -90,7 +90,10 @@ export class AvatarView {
 
   /** The head pose: its rotation turns the head bone; the translation (mm of the template) is not applied. */
   setPose(rx: number, ry: number, rz: number): void {
-    this.shown.head.set([rx, ry, rz]);
+    const h = this.shown.head; // kept for the fade to rest; set in place: nothing is allocated per frame
+    h[0] = rx;
+    h[1] = ry;
+    h[2] = rz;
     this.avatar.setHeadRotation(rx, ry, rz);
     this.requestRender();
   }

@@ -36,4 +36,3 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   root.append(style, canvas, status);
   return { canvas, status };
 }
-

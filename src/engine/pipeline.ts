@@ -134,12 +134,11 @@ export class Pipeline {
    * weights of the rest (restArkit) and the visemes at viseme_sil.
    */
   async holdRest(animation: Animation): Promise<void> {
-    const rest = await this.restFace();
+    const rest = this.offsetsOf(await this.restFace());
     const n3 = rest.length;
-    const mm = this.mmPerUnit;
     const offsets = new Float32Array(animation.frames * n3);
-    for (let f = 0; f < animation.frames; f++) for (let i = 0; i < n3; i++) offsets[f * n3 + i] = rest[i] * mm - this.templateMm[i];
-    const posed = poseFrames(this.templateMm, offsets, animation.pose, animation.frames, mm);
+    for (let f = 0; f < animation.frames; f++) offsets.set(rest, f * n3);
+    const posed = poseFrames(this.templateMm, offsets, animation.pose, animation.frames, this.mmPerUnit);
     if (animation.vertices.length) animation.vertices.set(posed.vertices);
     animation.unposed?.set(posed.unposed);
     animation.tongue.fill(0); // at rest, as in silence
@@ -160,11 +159,18 @@ export class Pipeline {
   restArkit(): Promise<Float32Array> {
     this.restWeights ??= this.restFace().then((rest) => {
       const out = new Float32Array(ARKIT_NAMES.length);
-      const offsets = Float32Array.from(rest, (x, i) => x * this.mmPerUnit - this.templateMm[i]);
-      this.avatarWeights.solver.solve(offsets, 0, this.avatarWeights.newState(), out);
+      this.avatarWeights.solver.solve(this.offsetsOf(rest), 0, this.avatarWeights.newState(), out);
       return out;
+    }, (e: unknown) => {
+      this.restWeights = null; // not kept, as restFace's failure is not
+      throw e;
     });
     return this.restWeights;
+  }
+
+  /** The displacement O (mm) of a face `unposed` (template units): what the decoder and the solver work in. */
+  private offsetsOf(unposed: Float32Array): Float32Array {
+    return Float32Array.from(unposed, (x, i) => x * this.mmPerUnit - this.templateMm[i]);
   }
 
   /**

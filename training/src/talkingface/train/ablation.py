@@ -45,8 +45,9 @@ def run_row(corpus: str, row: str, seed: int, steps: int, runs: Path, extra: lis
             stale.unlink(missing_ok=True)
         train.main(argv)
     cached = out / "ablation_eval.json"
-    if cached.exists() and cached.stat().st_mtime >= final.stat().st_mtime and json.loads(cached.read_text()).get("corpus") == corpus:
-        return json.loads(cached.read_text())  # evaluation is deterministic: reuse it for this checkpoint and corpus
+    before = json.loads(cached.read_text()) if cached.exists() and cached.stat().st_mtime >= final.stat().st_mtime else None
+    if before and before.get("corpus") == corpus:
+        return before  # evaluation is deterministic: reuse it for this checkpoint and corpus
     ds = open_dataset(corpus)
     model, ck = train.load_checkpoint(final, ds.template)
     res = evaluate(model, ds, "test")
