@@ -1,7 +1,7 @@
 import { defineConfig, defaultClientConditions, type Plugin } from 'vite';
 import { createReadStream, existsSync, statSync, cpSync, readFileSync } from 'node:fs';
 import { resolve, normalize, sep, extname } from 'node:path';
-import { ISOLATION_HEADERS, MIME, precompress, serveBuild } from './scripts/hosting';
+import { ISOLATION_HEADERS, MIME, precompress, serveBuild } from './scripts/hosting.ts';
 
 /**
  * Cross-origin isolation (ISOLATION_HEADERS) lets onnxruntime-web use threads (SharedArrayBuffer).

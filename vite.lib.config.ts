@@ -1,8 +1,8 @@
 import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { precompress } from './scripts/hosting';
-import { vendorTalkingHead } from './scripts/talkinghead-vendor';
+import { precompress } from './scripts/hosting.ts';
+import { vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
 
 /**
  * The library build: dist/lib/talking-face.js (ES module) defines <talking-face> and exports the API

@@ -185,13 +185,15 @@ def copy_template(source: Path | None, out: Path) -> str | None:
     return f"copied the face template ({source.parent}) to {there.parent}"
 
 
-def export(checkpoint: Path, out: Path, template: Template | None = None) -> dict:
-    """Write the browser's files for `checkpoint` into `out`; `template` defaults to the one the checkpoint names."""
-    from .train.train import checkpoint_template, load_checkpoint
+def export(checkpoint: Path, out: Path, template: Template | None = None, ck: dict | None = None) -> dict:
+    """Write the browser's files for `checkpoint` into `out`; `template` defaults to the one the checkpoint names;
+    `ck`: the checkpoint already read (read_checkpoint), so that it is read once."""
+    from .train.train import checkpoint_template, model_of
+    ck = read_checkpoint(checkpoint) if ck is None else ck
     if template is None:
-        template = checkpoint_template(read_checkpoint(checkpoint))
+        template = checkpoint_template(ck)
     check_out_template(out, template)
-    model, ck = load_checkpoint(checkpoint, template)
+    model, ck = model_of(ck, template, checkpoint)
     model.eval()
     cfg, a = model.cfg, model.audio
     out.mkdir(parents=True, exist_ok=True)
@@ -229,7 +231,7 @@ def export(checkpoint: Path, out: Path, template: Template | None = None) -> dic
     closer = LipClosure(template, template_mm, closure["reference_gap_mm"], closure.get("mouth_gain", 1.0)) if closure else None
     fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head, closer)
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
-        slim = {k: v for k, v in torch.load(checkpoint, map_location="cpu", weights_only=False).items() if k != "optimizer"}
+        slim = {k: v for k, v in ck.items() if k != "optimizer"}
         torch.save(slim, out / "checkpoint.pt")
 
     all_files = {**files, "fixtures": fixtures["file"]}
@@ -297,8 +299,9 @@ def main(argv=None) -> int:
     if not args.checkpoint.exists():
         print(f"error: checkpoint {args.checkpoint} does not exist (train one: python -m talkingface.train.train)", file=sys.stderr)
         return 2
-    m = export(args.checkpoint, args.out, load_template(args.template, args.masks) if args.template else None)
-    named = args.template or Path(torch.load(args.checkpoint, map_location="cpu", weights_only=False).get("template_path", ""))
+    ck = read_checkpoint(args.checkpoint)
+    m = export(args.checkpoint, args.out, load_template(args.template, args.masks) if args.template else None, ck)
+    named = args.template or Path(ck.get("template_path", ""))
     if said := copy_template(named if str(named) else None, args.out):
         print(said, file=sys.stderr)
     print(f"exported {m['model']['name']} ({m['model']['parameters']:,} parameters): runtime files {m['runtime_bytes'] / 1e6:.2f} MB -> {args.out}")

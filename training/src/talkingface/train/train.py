@@ -53,13 +53,17 @@ def checkpoint_template(ck: dict) -> Template:
 
 def load_checkpoint(path: Path, template: Template | None = None):
     """-> (model, checkpoint dict). `template` defaults to the one the checkpoint names (checkpoint_template)."""
-    ck = read_checkpoint(path)
+    return model_of(read_checkpoint(path), template, path)
+
+
+def model_of(ck: dict, template: Template | None = None, name: str | Path = "the checkpoint"):
+    """-> (model, ck) from a checkpoint already read (read_checkpoint); `name` says which file in an error."""
     cfg = ModelConfig.from_dict(ck["model_config"])
     audio = AudioConfig(**ck["audio_config"])
     if template is None:
         template = checkpoint_template(ck)
     if template.id != ck["template_id"]:
-        raise ValueError(f"{path} was trained on template {ck['template_id']}, not {template.id}")
+        raise ValueError(f"{name} was trained on template {ck['template_id']}, not {template.id}")
     model = TalkingFace(cfg, template, audio)
     model.load_state_dict(ck["model"])
     return model, ck
