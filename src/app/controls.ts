@@ -12,7 +12,7 @@ export const ui = {
   playButton: $<HTMLButtonElement>('play-button'),
   loopCheck: $<HTMLInputElement>('loop-check'),
   scrub: $<HTMLInputElement>('scrub'),
-  timeLabel: $<HTMLOutputElement>('time-label'),
+  timeLabel: $<HTMLSpanElement>('time-label'),
   clipInfo: $<HTMLParagraphElement>('clip-info'),
   setupInfo: $<HTMLParagraphElement>('setup-info'),
   takeInfo: $<HTMLParagraphElement>('take-info'),
@@ -52,6 +52,8 @@ export function enableControls(s: ControlsState): void {
   for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
   ui.headRerollButton.disabled = ui.headScale.disabled = !playable || !s.headMotion || (s.busy && !s.headRedraw);
   ui.recordButton.disabled = s.busy;
+  // Cancel hides once the work ends: its focus goes to what comes next, not to the page's start.
+  if (!s.busy && document.activeElement === ui.cancelButton) (playable ? ui.playButton : ui.recordButton).focus();
   ui.cancelButton.hidden = !s.busy;
 }
 
@@ -113,8 +115,8 @@ export interface ControlActions {
   setArrows(on: boolean): void;
   repaint(): void;
   setSideBySide(on: boolean): void;
-  /** A click on the face at client coordinates (x, y), when painting one vertex's attention. */
-  pick(x: number, y: number): void;
+  /** When painting one vertex's attention: a click on the face (client coordinates), or [ / ] (-1, 1) by keyboard. */
+  pick(at: { x: number; y: number } | number): void;
   setBackend(choice: string): void;
   exportGlb(): void;
   exportRaw(): void;
@@ -132,7 +134,12 @@ export function bindControls(a: ControlActions): void {
   ui.sideCheck.addEventListener('change', () => a.setSideBySide(ui.sideCheck.checked));
   ui.loopCheck.addEventListener('change', () => a.setLoop(ui.loopCheck.checked));
   ui.canvas.addEventListener('click', (ev) => {
-    if (ui.paintSelect.value === 'vertex-attention') a.pick(ev.clientX, ev.clientY);
+    if (ui.paintSelect.value === 'vertex-attention') a.pick({ x: ev.clientX, y: ev.clientY });
+  });
+  ui.canvas.addEventListener('keydown', (ev) => {
+    if (ui.paintSelect.value !== 'vertex-attention' || (ev.key !== '[' && ev.key !== ']')) return;
+    ev.preventDefault();
+    a.pick(ev.key === ']' ? 1 : -1);
   });
   ui.exportGlbButton.addEventListener('click', () => a.exportGlb());
   ui.exportRawButton.addEventListener('click', () => a.exportRaw());

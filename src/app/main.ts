@@ -199,14 +199,14 @@ function redrawTakeHead(change: HeadChange): void {
 function play(): void {
   if (!take) return;
   ui.playButton.textContent = 'Pause';
-  tell(takeNote || `Playing ${take.name}: Space or Escape pauses.`);
+  tell(takeNote ? `Playing. ${takeNote}` : `Playing ${take.name}: Space or Escape pauses.`);
   void player.play();
 }
 
 /** After playback stops: the status says so (keeping the take's note) and what to do next. */
 function showPaused(what: string): void {
   ui.playButton.textContent = 'Play';
-  if (take) tell(takeNote || `${what}: press Play to watch it again, or open another file.`);
+  if (take) tell(takeNote ? `${what}. ${takeNote}` : `${what}: press Play to watch it again, or open another file.`);
 }
 
 function stopPlayback(): void {
@@ -304,7 +304,7 @@ bindControls({
     publish();
     if (take) player.show(player.current);
   },
-  pick: (x, y) => takeView.pick(x, y) && takeView.paint(take, engine, player.current, player.isPlaying),
+  pick: (at) => takeView.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
@@ -317,8 +317,7 @@ bindKeys({
   hasTake: () => take !== null,
   togglePlay,
   step: (delta) => showFrame(player.current + delta),
-  orbit: (azimuth, polar) => view?.orbit(azimuth, polar),
-  zoom: (factor) => view?.zoom(factor),
+  view: () => view ?? null, // null until the face is drawn
 });
 for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
 

@@ -28,8 +28,17 @@ export interface PaintRequest {
 export class Painter {
   private job = 0;
 
-  /** `legend(html)` shows a legend line; `legend(null)` hides it. `painted(mode)` is told when a map is drawn. */
-  constructor(private readonly view: FaceView, private readonly legend: (html: string | null) => void, private readonly painted: (mode: string) => void) {}
+  /**
+   * `legend(html)` shows a legend line; `legend(null)` hides it. `painted(mode)` is told when a map is drawn;
+   * `notice(text)` of why none is (screen readers hear it: the legend is not a live region).
+   */
+  constructor(private readonly view: FaceView, private readonly legend: (html: string | null) => void, private readonly painted: (mode: string) => void,
+    private readonly notice: (text: string) => void) {}
+
+  private explain(text: string): void {
+    this.legend(text);
+    this.notice(text);
+  }
 
   paint(r: PaintRequest | null): void {
     const job = ++this.job;
@@ -42,7 +51,7 @@ export class Painter {
     if (r.mode === 'error') {
       if (!r.truth) {
         this.view.setColorMap(null);
-        this.legend('The error map needs a sample clip (it has ground truth).');
+        this.explain('The error map needs a sample clip (it has ground truth).');
         return;
       }
       const f = Math.min(r.frame, r.truth.frames - 1);
@@ -54,7 +63,7 @@ export class Painter {
       return;
     }
     if (r.playing) {
-      this.legend('Attention maps are computed for the paused frame: pause or scrub.');
+      this.explain('Attention maps are computed for the paused frame: pause or scrub.');
       return;
     }
     void r.engine.attentionAt(r.samples, r.frame).then((maps) => {
@@ -71,9 +80,9 @@ export class Painter {
         for (let k = maps.keyStart[j]; k < maps.keyStart[j + 1]; k++) max = Math.max(max, (values[maps.keys[k]] = maps.vertexWeights[k]));
         this.view.setColorMap(values, max);
         this.legend(`Vertex ${j}'s attention over itself and its ${maps.keyStart[j + 1] - maps.keyStart[j] - 1} neighbours, layer ${maps.layer + 1} (paper Fig. 10): ` +
-          `0<span class="ramp"></span>${max.toFixed(3)}. Click the face to choose another vertex.`);
+          `0<span class="ramp"></span>${max.toFixed(3)}. Click the face, or press [ or ], to choose another vertex.`);
       }
       this.painted(r.mode);
-    }, (err: Error) => this.legend(`Attention map failed: ${err.message}`));
+    }, (err: Error) => this.explain(`Attention map failed: ${err.message}`));
   }
 }

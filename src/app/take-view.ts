@@ -3,13 +3,13 @@
  * the scrubber and time, the painted maps, and E_vl against a sample's truth.
  */
 import { FaceView } from '../render/face-view';
-import { lipMask as lipMaskOf } from '../template/face-template';
+import { lipMask as lipMaskOf, type FaceTemplate } from '../template/face-template';
 import { innerLipGaps } from '../template/lip-gap';
 import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
+import { announce, headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
 import { audioNotes } from '../player/player';
 import { raiseIfQuiet } from '../audio/decode';
 
@@ -33,9 +33,10 @@ export class TakeView {
   private readonly painter: Painter;
   private readonly lipMask: Uint8Array;
   private picked: number | null = null;
+  private lipRing: number[] | null = null;
 
   constructor(private readonly view: FaceView) {
-    this.painter = new Painter(view, showLegend, (mode) => (document.body.dataset.painted = mode));
+    this.painter = new Painter(view, showLegend, (mode) => (document.body.dataset.painted = mode), announce);
     this.lipMask = lipMaskOf(view.template);
     addEventListener('resize', () => this.timeline.redraw());
   }
@@ -79,7 +80,9 @@ export class TakeView {
     }
     this.timeline.setPlayhead(f);
     ui.scrub.value = String(f);
-    ui.timeLabel.value = `${(f / take.animation.fps).toFixed(2)} s`;
+    const fps = take.animation.fps;
+    ui.timeLabel.textContent = `${(f / fps).toFixed(2)} s`; // not a live region: it changes every frame
+    ui.scrub.setAttribute('aria-valuetext', `${(f / fps).toFixed(2)} s of ${(take.animation.frames / fps).toFixed(2)} s`);
     this.paint(take, engine, f, playing);
   }
 
@@ -93,9 +96,18 @@ export class TakeView {
     });
   }
 
-  /** Choose the vertex whose attention is painted (a click on the face); true when one was hit. */
-  pick(x: number, y: number): boolean {
-    const v = this.view.pickVertex(x, y);
+  /**
+   * Choose the vertex whose attention is painted: the one under a click at client coordinates, or by keyboard the
+   * next (1) or previous (-1) vertex round the lips' outline, anticlockwise seen from the front; true when one was chosen.
+   */
+  pick(at: { x: number; y: number } | number): boolean {
+    let v: number | null;
+    if (typeof at === 'number') {
+      const ring = (this.lipRing ??= lipOutline(this.view.template));
+      const upper = this.view.template.regions.lips_outer_upper;
+      const i = ring.indexOf(this.picked ?? upper[Math.floor(upper.length / 2)]); // the default shown (paint.ts)
+      v = ring[(Math.max(i, 0) + at + ring.length) % ring.length] ?? null;
+    } else v = this.view.pickVertex(at.x, at.y);
     if (v !== null) this.picked = v;
     return v !== null;
   }
@@ -176,4 +188,14 @@ export async function animateAudio(e: TalkingFaceEngine, name: string, given: Fl
   const computeMs = performance.now() - t0;
   const speech = await e.restUnlessSpeech(animation);
   return { animation, computeMs, samples, notes: audioNotes(given, seconds, { speech, raisedDb: gainDb }) };
+}
+
+/** The lips' outer outline, ordered by angle round its centre (seen from the front): where [ and ] go. */
+function lipOutline(t: FaceTemplate): number[] {
+  const ring = t.regions.lips_outer;
+  const p = t.positions;
+  let cx = 0, cy = 0;
+  for (const v of ring) [cx, cy] = [cx + p[v * 3] / ring.length, cy + p[v * 3 + 1] / ring.length];
+  const angle = (v: number) => Math.atan2(p[v * 3 + 1] - cy, p[v * 3] - cx);
+  return [...ring].sort((a, b) => angle(a) - angle(b));
 }

@@ -30,6 +30,8 @@ export class AvatarView {
   private frameHandle = 0;
   private readonly blinks = new Blinks(performance.now());
   private blink = 0;
+  /** A visitor who asked for reduced motion gets no idle blinks (face-view.ts holds its life still likewise). */
+  private readonly reducedMotion = globalThis.matchMedia?.('(prefers-reduced-motion: reduce)') ?? null;
   /** The frame last given (weights, visemes, head rotation) and how much of it is shown: 1, fading to 0 (the rest) after speech. */
   private readonly shown = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length), head: new Float32Array(3) };
   private readonly scaled = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length) };
@@ -157,7 +159,7 @@ export class AvatarView {
     this.frameHandle = requestAnimationFrame(this.loop);
     if (this.controls.update()) this.needsRender = true;
     if (this.fading) this.fade(performance.now() / 1000);
-    const blink = this.avatar.canBlink ? this.blinks.at(performance.now()) : 0;
+    const blink = this.avatar.canBlink && !this.reducedMotion?.matches ? this.blinks.at(performance.now()) : 0;
     if (blink !== this.blink) {
       this.blink = blink;
       this.avatar.setIdleBlink(blink);

@@ -1,12 +1,14 @@
 /** <talking-face>'s shadow DOM: its style, the canvas a view draws on, the status line. */
+import { CAMERA_KEYS_TEXT } from '../render/camera-keys';
 
 export const STYLE = `
 :host { display: block; position: relative; width: 100%; aspect-ratio: 4 / 3; min-height: 160px; background: #15181d; border-radius: 8px; overflow: hidden; contain: content; }
 canvas { display: block; width: 100%; height: 100%; outline: none; }
-canvas:focus-visible { box-shadow: inset 0 0 0 3px #7ab8ff; }
+canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
 .status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45); }
 .status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
-:host([hide-status]) .status:not(.error) { display: none; }
+:host([hide-status]) .status:not(.error) { display: none; } /* the announcer still speaks */
+.announce { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 `;
 
 /**
@@ -17,13 +19,18 @@ export function newCanvas(): HTMLCanvasElement {
   const canvas = document.createElement('canvas');
   canvas.setAttribute('part', 'canvas');
   canvas.tabIndex = 0;
-  canvas.setAttribute('role', 'img');
-  canvas.setAttribute('aria-label', 'Animated 3D face. Drag to orbit, scroll to zoom.');
+  canvas.setAttribute('role', 'application'); // the arrow keys are its own (camera-keys.ts), not a screen reader's
+  canvas.setAttribute('aria-roledescription', '3D face viewer');
+  canvas.setAttribute('aria-label', `Animated 3D face. ${CAMERA_KEYS_TEXT}.`);
   return canvas;
 }
 
-/** The style, a canvas and the status line (a polite live region) in a new shadow root. */
-export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; status: HTMLParagraphElement } {
+/**
+ * The style, a canvas, the status line and, for screen readers, a polite live region that hears of changes of state
+ * only (loading, ready, playing, stopped, errors): the status line's progress ("frame 96 of 480") would be spoken
+ * at every chunk.
+ */
+export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; status: HTMLParagraphElement; announcer: HTMLElement } {
   const root = host.attachShadow({ mode: 'open' });
   const style = document.createElement('style');
   style.textContent = STYLE;
@@ -31,8 +38,11 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   const status = document.createElement('p');
   status.className = 'status';
   status.setAttribute('part', 'status');
-  status.setAttribute('role', 'status');
-  status.setAttribute('aria-live', 'polite');
-  root.append(style, canvas, status);
-  return { canvas, status };
+  status.setAttribute('aria-hidden', 'true'); // the announcer says it once
+  const announcer = document.createElement('span');
+  announcer.className = 'announce';
+  announcer.setAttribute('role', 'status');
+  announcer.setAttribute('aria-live', 'polite');
+  root.append(style, canvas, status, announcer);
+  return { canvas, status, announcer };
 }

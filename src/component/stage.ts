@@ -8,6 +8,7 @@ import { AvatarView } from '../avatar/avatar-view';
 import type { FaceTemplate } from '../template/face-template';
 import { Player, type PlayerOptions } from '../player/player';
 import { newCanvas } from './parts';
+import { cameraKey } from '../render/camera-keys';
 
 export class ElementStage {
   view: FaceView | AvatarView | null = null;
@@ -30,6 +31,7 @@ export class ElementStage {
     const canvas = newCanvas();
     this.canvas.replaceWith(canvas);
     this.canvas = canvas;
+    canvas.addEventListener('keydown', (ev) => cameraKey(ev, canvas === this.canvas ? this.view : null));
     const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, headBone)
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;

@@ -31,6 +31,7 @@ export class TalkingFaceElement extends HTMLElement {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
 
   private readonly statusLine: HTMLParagraphElement;
+  private readonly announcer: HTMLElement;
   private readonly stage: ElementStage;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
@@ -45,8 +46,8 @@ export class TalkingFaceElement extends HTMLElement {
 
   constructor() {
     super();
-    const { canvas, status } = shadowParts(this);
-    this.statusLine = status;
+    const { canvas, status, announcer } = shadowParts(this);
+    [this.statusLine, this.announcer] = [status, announcer];
     this.stage = new ElementStage(canvas, {
       onFrame: (f) => this.playbackFrame(f),
       onEnded: () => this.dispatchEvent(new CustomEvent('ended')),
@@ -133,6 +134,7 @@ export class TalkingFaceElement extends HTMLElement {
     const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
     const t0 = performance.now();
     const quiet = raiseIfQuiet(decoded.samples); // quiet speech would be taken for none
+    this.setStatus('Animating…');
     let animation: Animation, computeMs: number, speech: boolean;
     try {
       animation = await engine.animate(quiet.samples, {
@@ -140,7 +142,7 @@ export class TalkingFaceElement extends HTMLElement {
         blendshapes: this.blendshapes,
         headMotionScale: this.headMotionScale,
         signal,
-        onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`),
+        onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`, false, false),
       });
       computeMs = performance.now() - t0;
       speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
@@ -295,9 +297,11 @@ export class TalkingFaceElement extends HTMLElement {
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: playbackFrameDetail(this.engine, a, frame, this.computeMs, this.audioSeconds) }));
   }
 
-  private setStatus(text: string, isError = false): void {
+  /** The status line; `announce`: a change of state that screen readers hear too (not progress). */
+  private setStatus(text: string, isError = false, announce = true): void {
     this.statusLine.textContent = text;
     this.statusLine.classList.toggle('error', isError);
+    if (announce && this.announcer.textContent !== text) this.announcer.textContent = text;
   }
 
   /** Show and dispatch an error; returns it so callers can throw it. */

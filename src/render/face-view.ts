@@ -39,8 +39,6 @@ export interface FaceViewOptions {
 
 /** Seconds for speech to blend in, and back out to the rest face. */
 const BLEND_IN = 0.12, BLEND_OUT = 0.4;
-const scratchOffset = new THREE.Vector3();
-const scratchSpherical = new THREE.Spherical();
 const scratchAxis = new THREE.Vector3();
 const scratchQ = new THREE.Quaternion();
 const eyeTarget = new THREE.Vector3();
@@ -58,6 +56,7 @@ export class FaceView {
   idleState: IdleState | null = null;
   private readonly idle: IdleMotion | null;
   private lifePaused: boolean;
+  private readonly reducedMotion = globalThis.matchMedia?.('(prefers-reduced-motion: reduce)') ?? null;
   private readonly blink: Float32Array;
   private readonly shown: Float32Array;
   private readonly frame: Float32Array;
@@ -133,6 +132,11 @@ export class FaceView {
     this.lifePaused = paused;
   }
 
+  /** Whether the life moves now: not paused, and the visitor has not asked for reduced motion (it is held still then). */
+  private get alive(): boolean {
+    return !this.lifePaused && !this.reducedMotion?.matches;
+  }
+
   /** The face's vertices drawn now (template units, N x 3), read-only. */
   get shownVertices(): Float32Array {
     return this.shown;
@@ -180,27 +184,6 @@ export class FaceView {
 
   requestRender(): void {
     this.needsRender = true;
-  }
-
-  /** Turn the camera around the face (radians: left-right, up-down), as a drag would: the keyboard's orbit. */
-  orbit(azimuth: number, polar: number): void {
-    const offset = scratchOffset.copy(this.camera.position).sub(this.controls.target);
-    scratchSpherical.setFromVector3(offset);
-    scratchSpherical.theta += azimuth;
-    scratchSpherical.phi = Math.min(Math.PI - 0.05, Math.max(0.05, scratchSpherical.phi + polar));
-    this.camera.position.copy(this.controls.target).add(offset.setFromSpherical(scratchSpherical));
-    this.camera.lookAt(this.controls.target);
-    this.controls.update();
-    this.requestRender();
-  }
-
-  /** Move the camera towards the face (factor < 1) or away from it (> 1), as the scroll wheel would. */
-  zoom(factor: number): void {
-    const offset = scratchOffset.copy(this.camera.position).sub(this.controls.target);
-    const distance = Math.min(this.controls.maxDistance, Math.max(this.controls.minDistance, offset.length() * factor));
-    this.camera.position.copy(this.controls.target).add(offset.setLength(distance));
-    this.controls.update();
-    this.requestRender();
   }
 
   /**
@@ -252,10 +235,10 @@ export class FaceView {
       changed = true;
     } else if (!this.rest) this.speech = this.speechTarget;
     const before = this.idleState?.blink ?? 0;
-    if (this.idle) {
+    if (this.idle && this.alive) {
       this.idleState = this.idle.at(seconds);
       changed ||= this.idleState.blink > 0 || before > 0;
-    }
+    } else if (this.idleState) [this.idleState, changed] = [null, true]; // held still: eyes open, ahead, at rest
     if (changed) this.compose();
     this.applyPose();
     this.head.updateMatrixWorld();
@@ -263,7 +246,7 @@ export class FaceView {
     this.head.worldToLocal(eyeTarget);
     const s = this.idleState;
     this.model.eyes.lookAt(eyeTarget, s?.yaw ?? 0, s?.pitch ?? 0);
-    if (s) this.model.body.scale.y = this.bodyHeight * (1 + 0.012 * s.breath);
+    this.model.body.scale.y = this.bodyHeight * (1 + 0.012 * (s?.breath ?? 0));
   }
 
   dispose(): void {
@@ -304,7 +287,7 @@ export class FaceView {
     this.frameHandle = requestAnimationFrame(this.loop);
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
-    if ((this.idle && !this.lifePaused) || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
+    if ((this.idle && this.alive) || this.idleState || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
     if (!this.needsRender) return;
     this.needsRender = false;
     this.renderer.render(this.scene, this.camera);
