@@ -137,16 +137,27 @@ export interface CaptureOptions {
   block?: number;
   /** Play the stream to the speakers as well (default false: no feedback loop with a microphone). */
   monitor?: boolean;
+  /**
+   * Called when sound stops arriving (once, until a track comes back): every audio track of the stream has ended or
+   * left it (a microphone unplugged, its track stopped, a page's clip over), or the browser suspended the audio and
+   * would not resume it. The capture goes on, silent, and follows an audio track added to the stream later; stop it
+   * to release the microphone.
+   */
+  onInterrupted?: (error: MicrophoneError) => void;
 }
+
+/** How long a suspended context is given to resume before the capture says it was interrupted. */
+const RESUME_WAIT_MS = 1000;
 
 /** A running capture: stop() releases the worklet, the context and (if asked) the stream's tracks. */
 export class AudioCapture {
   private stopped = false;
+  private unwatch: () => void = () => undefined;
 
   private constructor(
     readonly context: AudioContext,
     private readonly node: AudioWorkletNode,
-    private readonly source: MediaStreamAudioSourceNode,
+    private source: MediaStreamAudioSourceNode,
     readonly stream: MediaStream,
     /** The rate of the pieces handed to onSamples (the model's). */
     readonly sampleRate: number,
@@ -208,13 +219,54 @@ export class AudioCapture {
         throw new Error(`the audio system would not start (${(e as Error).message}); click the page and try again`);
       }
     }
-    return new AudioCapture(context, node, source, stream, sampleRate, rate, capture);
+    const made = new AudioCapture(context, node, source, stream, sampleRate, rate, capture);
+    made.watch(options.onInterrupted, Boolean(options.monitor));
+    return made;
+  }
+
+  /** Follow the stream's tracks and the context's state (CaptureOptions.onInterrupted). */
+  private watch(onInterrupted: CaptureOptions['onInterrupted'], monitor: boolean): void {
+    const { stream, context } = this;
+    const live = () => stream.getAudioTracks().some((t) => t.readyState === 'live');
+    let said = false; // once per interruption: a track added starts another
+    const say = (why: string) => {
+      if (this.stopped || said) return;
+      said = true;
+      onInterrupted?.(new MicrophoneError(why));
+    };
+    const gone = () => live() || say('the microphone stopped sending sound (unplugged, or its track was stopped)');
+    const added = (ev: MediaStreamTrackEvent) => {
+      if (ev.track.kind !== 'audio' || ev.track.readyState !== 'live' || this.stopped) return;
+      // A source node stays on the track it was made with: a track added later (a page's clip played again) gets its own.
+      said = false;
+      this.source.disconnect();
+      this.source = context.createMediaStreamSource(new MediaStream([ev.track]));
+      this.source.connect(this.node);
+      if (monitor) this.source.connect(context.destination);
+      ev.track.addEventListener('ended', gone);
+    };
+    const suspended = () => {
+      if (this.stopped || context.state === 'running' || context.state === 'closed') return;
+      void context.resume().catch(() => undefined); // deliberate: whether it ran is read below
+      setTimeout(() => context.state !== 'running' && say('the browser suspended the audio (another application took it, or the page was put aside)'), RESUME_WAIT_MS);
+    };
+    for (const t of stream.getAudioTracks()) t.addEventListener('ended', gone);
+    stream.addEventListener('removetrack', gone);
+    stream.addEventListener('addtrack', added);
+    context.addEventListener('statechange', suspended);
+    this.unwatch = () => {
+      for (const t of stream.getAudioTracks()) t.removeEventListener('ended', gone);
+      stream.removeEventListener('removetrack', gone);
+      stream.removeEventListener('addtrack', added);
+      context.removeEventListener('statechange', suspended);
+    };
   }
 
   /** Stop capturing. `releaseStream` also stops the stream's tracks (the browser's recording indicator goes off). */
   async stop(releaseStream = true): Promise<void> {
     if (this.stopped) return;
     this.stopped = true;
+    this.unwatch();
     if (this.context.state === 'running') {
       // Wait for the worklet's last samples (bounded: a closed or stalled context must not hang stop()).
       await new Promise<void>((resolve) => {

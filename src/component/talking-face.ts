@@ -92,19 +92,14 @@ export class TalkingFaceElement extends HTMLElement {
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
     // Before the first connectedCallback (an upgrade calls this first, for every attribute) that call reads them all.
     if (old === value || !this.isConnected || !this.connected) return;
-    if (name === 'model' || name === 'template' || name.startsWith('avatar')) {
+    if (name === 'model' || name === 'template' || name.startsWith('avatar') || name === 'backend') {
+      // Elements share an engine per model, template and backend: a new backend takes the engine of its backend
+      // (the others keep theirs) and keeps its view (and does not autoplay again); `ready` tells the new backend.
+      const anew = name !== 'backend';
       this.stop();
-      this.loading = null;
-      this.engine = null;
-      this.stage.drop();
-      void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() reports its failure
-    } else if (name === 'backend') {
-      // Elements share an engine per model, template and backend: this one takes the engine of its new backend
-      // (the others keep theirs) and keeps its view; `ready` tells the new backend.
-      this.stop();
-      this.loading = null;
-      this.engine = null;
-      void this.load().then(() => this.afterLoad(false), () => undefined); // deliberate: load() reports its failure
+      [this.loading, this.engine] = [null, null];
+      if (anew) this.stage.drop();
+      void this.load().then(() => this.afterLoad(anew), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value && this.engine) {
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
@@ -182,6 +177,7 @@ export class TalkingFaceElement extends HTMLElement {
     try {
       media = await openMicrophone();
     } catch (e) {
+      if (gen !== this.generation) return; // stopped (or removed) while the browser asked: not a failure
       throw this.fail('microphone', (e as Error).message);
     }
     if (gen !== this.generation) {
@@ -194,8 +190,9 @@ export class TalkingFaceElement extends HTMLElement {
         if (gen !== this.generation || !this.stage.player) return;
         this.stage.player.showLive(frames);
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream.latency?.lastMs) }));
-      }, { onError: (e) => this.fail('inference', `live animation stopped: ${e.message}`), blendshapes: this.blendshapes,
-        headMotionScale: this.headMotionScale });
+      }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
+        onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),
+        blendshapes: this.blendshapes, headMotionScale: this.headMotionScale });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
       throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
@@ -224,12 +221,18 @@ export class TalkingFaceElement extends HTMLElement {
     const wasPlaying = this.stage.player?.isPlaying ?? false;
     this.stage.player?.stop();
     if (wasPlaying || this.live) (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
-    if (wasPlaying) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
+    if (wasPlaying || this.live) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
     if (this.live) {
-      const live = this.live;
+      const [live, gen] = [this.live, this.generation];
       this.live = null;
-      void live.stop().then(() => say && this.setStatus('Stopped listening.'));
+      void live.stop().then(() => say && gen === this.generation && this.setStatus('Stopped listening.'));
     } else if (say && (wasPlaying || cancelled)) this.setStatus('Stopped.');
+  }
+
+  /** Live listening failed or lost its sound: stopped (the microphone released, the face at rest) and reported. */
+  private lost(stage: TalkingFaceErrorDetail['stage'], message: string): void {
+    this.fail(stage, message);
+    this.halt(false);
   }
 
   private load(): Promise<TalkingFaceEngine> {

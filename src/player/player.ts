@@ -6,6 +6,7 @@
 import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
 import { SILENT_PEAK, levels } from '../audio/decode';
+import { SPEECH_PROBABILITY } from '../encoders/voice-activity';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -69,6 +70,8 @@ export interface PlayerOptions {
 
 /** How long a resumed audio context may take to run before it counts as held back by the autoplay rules. */
 const AUTOPLAY_WAIT_MS = 300;
+/** Live frames without speech after which the face goes back to rest (showLive): a breath between words does not. */
+const LIVE_REST_FRAMES = 12;
 /** The events that count as a person's gesture for the autoplay rules. */
 const GESTURES = ['pointerdown', 'pointerup', 'keydown', 'touchend'] as const;
 
@@ -88,6 +91,7 @@ export class Player {
   private context: AudioContext | null = null;
   private playing: Playing | null = null;
   private currentFrame = 0;
+  private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
   constructor(private readonly view: PlayerView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
@@ -133,13 +137,17 @@ export class Player {
     this.options.onFrame?.(f);
   }
 
-  /** Show the last frame of a streamed chunk (live). */
+  /**
+   * Show the last frame of a streamed chunk (live). After LIVE_REST_FRAMES frames without speech the face goes back
+   * to rest, and its life (blinks, breathing) with it, until speech comes again.
+   */
   showLive(frames: Frames): void {
     const last = frames.count - 1;
     const n3 = frames.unposed.length / frames.count;
+    for (let f = 0; f < frames.count; f++) this.liveQuiet = frames.speech[f] > SPEECH_PROBABILITY ? 0 : this.liveQuiet + 1;
     this.view.setTongue?.(frames.tongue[last] ?? 0);
     this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
-    this.view.setSpeaking?.(true);
+    this.view.setSpeaking?.(this.liveQuiet < LIVE_REST_FRAMES);
     if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, last);
     this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
   }

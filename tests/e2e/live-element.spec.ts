@@ -1,0 +1,108 @@
+import { resolve } from 'node:path';
+import { writeFileSync, mkdirSync } from 'node:fs';
+import { test, expect } from './fixtures';
+import { fakeMicrophone } from '../../playwright.config';
+import { speechSamples, wav } from './helpers/audio';
+
+/**
+ * <talking-face> listening when the microphone misbehaves (examples/embed.html): a track that ends (unplugged) stops
+ * listening with an error and `ended`; a suspended audio system is resumed; a restart keeps saying "Listening";
+ * stop() while the browser asks for permission is no failure; between phrases the face rests and blinks.
+ */
+// Speech, then 3 s of silence, looped by the fake microphone.
+const DIR = resolve(import.meta.dirname, '../../test-results');
+mkdirSync(DIR, { recursive: true });
+const PAUSED = resolve(DIR, 'speech-then-silence.wav');
+const { samples, rate } = speechSamples();
+const padded = new Float32Array(samples.length + 3 * rate);
+padded.set(samples);
+writeFileSync(PAUSED, wav([padded], rate));
+test.use({ launchOptions: fakeMicrophone(PAUSED) });
+
+type Page = import('@playwright/test').Page;
+
+/** Every stream getUserMedia gives (window.streams) and every element event (window.events), from the start. */
+const WATCH = () => {
+  const g = globalThis as unknown as { streams: MediaStream[]; events: string[]; micDelayMs: number; micDenied: boolean };
+  [g.streams, g.events, g.micDelayMs, g.micDenied] = [[], [], 0, false];
+  const getUserMedia = navigator.mediaDevices.getUserMedia.bind(navigator.mediaDevices);
+  navigator.mediaDevices.getUserMedia = async (c) => {
+    await new Promise((r) => setTimeout(r, g.micDelayMs));
+    if (g.micDenied) throw new DOMException('Permission dismissed', 'NotAllowedError');
+    const s = await getUserMedia(c);
+    g.streams.push(s);
+    return s;
+  };
+  for (const type of ['ended', 'error']) {
+    document.addEventListener(type, (e) => {
+      if ((e.target as HTMLElement).id === 'left') g.events.push(type === 'error' ? `error:${(e as CustomEvent).detail.stage}` : type);
+    }, true);
+  }
+};
+
+const status = (page: Page) => page.evaluate(() => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent!);
+const events = (page: Page) => page.evaluate(() => (globalThis as unknown as { events: string[] }).events);
+const start = (page: Page) => page.evaluate(() => void (document.getElementById('left') as unknown as { startMicrophone(): Promise<void> }).startMicrophone().catch(() => undefined));
+
+test.beforeEach(async ({ page }) => {
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html');
+  await page.evaluate(() => (document.getElementById('left') as unknown as { ready: Promise<unknown> }).ready);
+});
+
+test('a microphone unplugged mid-session stops listening with an error and ended; a suspended audio system resumes', async ({ page }) => {
+  test.setTimeout(90_000);
+  await start(page);
+  await expect.poll(() => status(page), { timeout: 20_000 }).toContain('Listening');
+  // The browser (or the page) suspends the audio: it is resumed, and listening goes on.
+  await page.evaluate(() => (document.getElementById('left') as unknown as { live: { capture: { context: AudioContext } } }).live.capture.context.suspend());
+  await expect.poll(() => page.evaluate(() => (document.getElementById('left') as unknown as { live: { capture: { context: AudioContext } } }).live.capture.context.state), { timeout: 5_000 }).toBe('running');
+  expect(await events(page)).toEqual([]);
+  // Unplugged: the track ends (as the browser ends it: readyState 'ended', then an 'ended' event).
+  await page.evaluate(() => {
+    const t = (globalThis as unknown as { streams: MediaStream[] }).streams[0].getAudioTracks()[0];
+    t.stop();
+    t.dispatchEvent(new Event('ended'));
+  });
+  await expect.poll(() => events(page), { timeout: 5_000 }).toEqual(['error:microphone', 'ended']);
+  expect(await status(page)).toMatch(/listening stopped: the microphone stopped sending sound/);
+  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { live: unknown }).live), 'the session is gone').toBeNull();
+});
+
+test('a restart keeps saying Listening; stop() while permission is asked is no failure', async ({ page }) => {
+  test.setTimeout(90_000);
+  await start(page);
+  await expect.poll(() => status(page), { timeout: 20_000 }).toContain('Listening');
+  await page.evaluate(() => {
+    const el = document.getElementById('left') as unknown as { stop(): void; startMicrophone(): Promise<void> };
+    el.stop();
+    void el.startMicrophone();
+  });
+  await page.waitForTimeout(3000); // the old session's stop has long resolved
+  expect(await status(page)).toContain('Listening');
+  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { live: { keepAudio: boolean } }).live.keepAudio), 'a long session keeps no audio').toBe(false);
+
+  await page.evaluate(() => (document.getElementById('left') as unknown as { stop(): void }).stop());
+  await page.evaluate(() => Object.assign(globalThis, { micDelayMs: 1500, micDenied: true, events: [] }));
+  const outcome = page.evaluate(() => (document.getElementById('left') as unknown as { startMicrophone(): Promise<void> }).startMicrophone().then(() => 'resolved', (e: Error) => `rejected: ${e.message}`));
+  await page.waitForTimeout(300);
+  await page.evaluate(() => (document.getElementById('left') as unknown as { stop(): void }).stop());
+  expect(await outcome).toBe('resolved');
+  expect(await events(page)).toEqual([]);
+  expect(await status(page)).not.toContain('denied');
+});
+
+test('between phrases the live face goes back to rest (its idle life, blinks included, comes back)', async ({ page }) => {
+  test.setTimeout(90_000);
+  await start(page);
+  const weight = () => page.evaluate(() => (document.getElementById('left') as unknown as { stage: { view: { speechWeight: number } } }).stage.view.speechWeight);
+  // Speech (about 3 s), then 3 s of silence, looped. Before any frame the face shows its initial state (1) until
+  // the rest is given (0); then: speaking (1), and at rest again (0) in the silence.
+  const seen: number[] = [];
+  const pattern = /^1*0+1+0/;
+  for (let i = 0; i < 80 && !pattern.test(seen.join('')); i++) {
+    seen.push(Math.round(await weight()));
+    await page.waitForTimeout(150);
+  }
+  expect(seen.join(''), 'at rest, speaking, at rest').toMatch(pattern);
+});
