@@ -17,8 +17,8 @@ import { softwareWebGL } from '../render/software-gl';
 
 /** About a head's bounding radius in metres (glTF's unit). */
 const HEAD_RADIUS = 0.15;
-/** Seconds the face takes back to neutral after speech (setSpeaking(false)), as the template face's (face-view.ts). */
-const BLEND_OUT = 0.4;
+/** Seconds speech takes to blend in from the rest, and back out to it (setSpeaking), as the template face's (face-view.ts). */
+const BLEND_IN = 0.12, BLEND_OUT = 0.4;
 
 export class AvatarView {
   readonly renderer: THREE.WebGLRenderer;
@@ -32,13 +32,14 @@ export class AvatarView {
   private blink = 0;
   /** A visitor who asked for reduced motion gets no idle blinks (face-view.ts holds its life still likewise). */
   private readonly reducedMotion = globalThis.matchMedia?.('(prefers-reduced-motion: reduce)') ?? null;
-  /** The frame last given (weights, visemes, head rotation) and how much of it is shown: 1, fading to 0 (the rest) after speech. */
+  /** The frame last given (weights, visemes, head rotation); how much of it is shown against the rest is `speech`. */
   private readonly shown = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length), head: new Float32Array(3) };
   private readonly scaled = { arkit: new Float32Array(ARKIT_NAMES.length), visemes: new Float32Array(VISEME_NAMES.length) };
   /** The ARKit weights of the model's face at rest (setRest; 0 until given): what the avatar shows before and after speech. */
   private readonly rest = new Float32Array(ARKIT_NAMES.length);
+  /** The weight of the frame given against the rest (0: the rest alone), ramping to `target` (setSpeaking). */
   private speech = 0;
-  private fading = false;
+  private target = 0;
   private lastTime = -1;
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
@@ -87,6 +88,11 @@ export class AvatarView {
     return new AvatarView(canvas, await GltfAvatar.parse(await res.arrayBuffer(), url, headBone));
   }
 
+  /** The speech weight now (0: the rest, 1: the frame given), as FaceView's. */
+  get speechWeight(): number {
+    return this.speech;
+  }
+
   /** The template's vertices: not the avatar's mesh, so nothing to do (the weights drive it). */
   setVertices(): void {}
 
@@ -96,7 +102,8 @@ export class AvatarView {
     h[0] = rx;
     h[1] = ry;
     h[2] = rz;
-    this.avatar.setHeadRotation(rx, ry, rz);
+    if (this.speech >= 1) this.avatar.setHeadRotation(rx, ry, rz);
+    else this.blend();
     this.requestRender();
   }
 
@@ -104,8 +111,9 @@ export class AvatarView {
   setBlendshapes(b: BlendshapeFrames, frame: number): void {
     this.shown.arkit.set(b.arkit.subarray(frame * ARKIT_NAMES.length, (frame + 1) * ARKIT_NAMES.length));
     this.shown.visemes.set(b.visemes.subarray(frame * VISEME_NAMES.length, (frame + 1) * VISEME_NAMES.length));
-    [this.speech, this.fading] = [1, false];
-    this.avatar.setWeights(b.arkit, frame * ARKIT_NAMES.length, b.visemes, frame * VISEME_NAMES.length);
+    this.target = 1;
+    if (this.speech >= 1) this.avatar.setWeights(b.arkit, frame * ARKIT_NAMES.length, b.visemes, frame * VISEME_NAMES.length);
+    else this.blend();
     this.requestRender();
   }
 
@@ -116,24 +124,24 @@ export class AvatarView {
   setRest(arkit: Float32Array): void {
     this.rest.set(arkit);
     if (this.speech > 0) return; // speaking: the rest shows once speech ends
-    this.lastTime = -1;
-    this.fade(0); // shown now (speech 0: the rest alone)
+    this.blend(); // shown now (speech 0: the rest alone)
   }
 
   /**
-   * Speech stopped (false: playback stopped or ended, the microphone closed): the face goes back to rest and the
-   * head to neutral over BLEND_OUT seconds, instead of holding the frame last shown (mid-word, when stopped).
+   * Speech starts (true: blended in from the rest over BLEND_IN seconds, so the head does not jump at its first frame)
+   * or stops (false: playback stopped or ended, the microphone closed, a pause live): the face goes back to rest and
+   * the head to neutral over BLEND_OUT seconds, instead of holding the frame last shown (mid-word, when stopped).
    */
   setSpeaking(on: boolean): void {
-    this.fading = !on && this.speech > 0;
-    if (on) this.speech = 1;
+    if (this.target === (on ? 1 : 0)) return;
+    this.target = on ? 1 : 0;
     this.lastTime = -1;
     this.requestRender();
   }
 
   /** Back to the avatar's own neutral face, at once. */
   reset(): void {
-    [this.speech, this.fading] = [0, false];
+    [this.speech, this.target] = [0, 0];
     this.avatar.reset();
     this.requestRender();
   }
@@ -158,7 +166,7 @@ export class AvatarView {
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
     if (this.controls.update()) this.needsRender = true;
-    if (this.fading) this.fade(performance.now() / 1000);
+    if (this.speech !== this.target) this.ramp(performance.now() / 1000);
     const blink = this.avatar.canBlink && !this.reducedMotion?.matches ? this.blinks.at(performance.now()) : 0;
     if (blink !== this.blink) {
       this.blink = blink;
@@ -170,12 +178,17 @@ export class AvatarView {
     this.renderer.render(this.scene, this.camera);
   };
 
-  /** One step of the fade to rest: the frame's weights and head rotation weighed by `speech` against the rest's (visemes: viseme_sil). */
-  private fade(seconds: number): void {
+  /** One step of `speech` towards `target`. */
+  private ramp(seconds: number): void {
     const dt = this.lastTime < 0 ? 0 : seconds - this.lastTime;
     this.lastTime = seconds;
-    this.speech = Math.max(0, this.speech - dt / BLEND_OUT);
-    this.fading = this.speech > 0;
+    const up = this.target > this.speech;
+    this.speech = up ? Math.min(1, this.speech + dt / BLEND_IN) : Math.max(0, this.speech - dt / BLEND_OUT);
+    this.blend();
+  }
+
+  /** The frame's weights and head rotation weighed by `speech` against the rest's (visemes: against viseme_sil). */
+  private blend(): void {
     const s = this.speech, { arkit, visemes } = this.scaled;
     for (let k = 0; k < arkit.length; k++) arkit[k] = s * this.shown.arkit[k] + (1 - s) * this.rest[k];
     for (let k = 0; k < visemes.length; k++) visemes[k] = s * this.shown.visemes[k];

@@ -24,10 +24,19 @@ import type { Animation } from '../engine/frames';
 import { blendshapesOf, type BlendshapeFrames } from './weights';
 import { ARKIT_INDEX, ARKIT_NAMES, type ArkitName } from './names';
 
+/** One shape's state in TalkingHead: `value` what it shows, `realtime` an override of its own animation. */
+interface Shape { realtime: number | null; needsUpdate: boolean; value?: number }
+
 /** What the driver uses of a TalkingHead instance: its morph-target state, one entry per name (Appendix F). */
 export interface TalkingHeadLike {
-  mtAvatar: Record<string, { realtime: number | null; needsUpdate: boolean }>;
+  mtAvatar: Record<string, Shape>;
 }
+
+/**
+ * Seconds over which a take takes over from TalkingHead's own animation (the shapes and the head blend from what
+ * TalkingHead showed), as this project's own views blend speech in (face-view.ts): not a jump at the first frame.
+ */
+const BLEND_IN = 0.12;
 
 /** The ARKit shapes handed to TalkingHead: all but eyeLook*, eyeBlink* and tongueOut (see above). */
 export const TALKINGHEAD_SHAPES: readonly ArkitName[] = ARKIT_NAMES.filter((n) => !/^eyeLook|^eyeBlink|^tongueOut$/.test(n));
@@ -60,6 +69,9 @@ export class TalkingHeadDriver {
   readonly missing: readonly ArkitName[];
   private readonly head: boolean;
   private active = false;
+  /** When the take took over (performance.now(), ms) and what TalkingHead showed then, by name. */
+  private since = 0;
+  private readonly from = new Map<string, number>();
 
   constructor(private readonly talkingHead: TalkingHeadLike, options: TalkingHeadOptions = {}) {
     if (!talkingHead?.mtAvatar || !('headRotateX' in talkingHead.mtAvatar)) {
@@ -73,38 +85,58 @@ export class TalkingHeadDriver {
 
   /** Frame `f` of a take's (or a streamed chunk's) blend-shape output. */
   show(blendshapes: BlendshapeFrames, f: number): void {
+    if (!blendshapes?.arkit) throw new TypeError('TalkingHeadDriver.show: the take has no blend shapes: animate it with { blendshapes: true }');
     const A = ARKIT_NAMES.length;
-    const mt = this.talkingHead.mtAvatar;
-    for (const name of this.shapes) set(mt[name], blendshapes.arkit[f * A + ARKIT_INDEX[name]]);
+    const w = this.takeOver();
+    for (const name of this.shapes) this.set(name, blendshapes.arkit[f * A + ARKIT_INDEX[name]], w);
     if (this.head) {
       const h = blendshapes.headRotation;
-      talkingHeadAngles(h[3 * f], h[3 * f + 1], h[3 * f + 2]).forEach((angle, k) => set(mt[TALKINGHEAD_HEAD[k]], angle));
+      talkingHeadAngles(h[3 * f], h[3 * f + 1], h[3 * f + 2]).forEach((angle, k) => this.set(TALKINGHEAD_HEAD[k], angle, w));
     }
-    this.active = true;
   }
 
   /** One frame by name, as <talking-face>'s `frame` event carries it (`detail.arkit`, `detail.headRotation`). */
   showNamed(arkit: Partial<Record<ArkitName, number>>, headRotation?: { yaw: number; pitch: number; roll: number }): void {
-    const mt = this.talkingHead.mtAvatar;
-    for (const name of this.shapes) if (arkit[name] !== undefined) set(mt[name], arkit[name]);
+    if (!arkit) throw new TypeError('TalkingHeadDriver.showNamed: the frame has no ARKit weights: give <talking-face> the blendshapes attribute (or an avatar)');
+    const w = this.takeOver();
+    for (const name of this.shapes) if (arkit[name] !== undefined) this.set(name, arkit[name], w);
     if (this.head && headRotation) {
-      talkingHeadAngles(headRotation.yaw, headRotation.pitch, headRotation.roll).forEach((angle, k) => set(mt[TALKINGHEAD_HEAD[k]], angle));
+      talkingHeadAngles(headRotation.yaw, headRotation.pitch, headRotation.roll).forEach((angle, k) => this.set(TALKINGHEAD_HEAD[k], angle, w));
     }
-    this.active = true;
   }
 
   /** Hand the shapes and the head back to TalkingHead's own animation (realtime null), after speech. */
   release(): void {
     if (!this.active) return;
     const mt = this.talkingHead.mtAvatar;
-    for (const name of [...this.shapes, ...(this.head ? TALKINGHEAD_HEAD : [])]) Object.assign(mt[name], { realtime: null, needsUpdate: true });
+    for (const name of this.driven()) if (mt[name]) Object.assign(mt[name], { realtime: null, needsUpdate: true });
     this.active = false;
   }
-}
 
-function set(target: { realtime: number | null; needsUpdate: boolean }, value: number): void {
-  target.realtime = value;
-  target.needsUpdate = true;
+  private driven(): readonly string[] {
+    return this.head ? [...this.shapes, ...TALKINGHEAD_HEAD] : this.shapes;
+  }
+
+  /** How far the take has taken over (0 at its first frame, 1 after BLEND_IN); the first frame notes what was shown. */
+  private takeOver(): number {
+    const now = performance.now();
+    if (!this.active) {
+      [this.active, this.since] = [true, now];
+      for (const name of this.driven()) this.from.set(name, this.talkingHead.mtAvatar[name]?.value ?? 0);
+    }
+    return Math.min(1, (now - this.since) / (BLEND_IN * 1000));
+  }
+
+  /**
+   * Shape `name` at `value`, `w` of the way from what TalkingHead showed. A shape the avatar no longer has (another
+   * avatar shown since the driver was made: make a new driver for it) is skipped, not a TypeError in TalkingHead's loop.
+   */
+  private set(name: string, value: number, w: number): void {
+    const target = this.talkingHead.mtAvatar[name];
+    if (!target) return;
+    target.realtime = w >= 1 ? value : (this.from.get(name) ?? 0) + w * (value - (this.from.get(name) ?? 0));
+    target.needsUpdate = true;
+  }
 }
 
 /**

@@ -122,3 +122,26 @@ test('an avatar that cannot be loaded makes speak() fail saying why; one replace
   expect((await seen(page, 'replaced')).filter((e) => e.startsWith('error'))).toEqual([]);
   expect(await status(page, 'replaced')).toMatch(/^Ready/);
 });
+
+test('speech blends in on an avatar: its weights and head go from the rest to the first frame over 0.12 s, not in one jump', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/examples/embed.html');
+  await addAvatar(page, 'b', '/examples/avatars/arkit-full-body.glb');
+  await expect.poll(() => seen(page, 'b'), { timeout: 90_000 }).toContain('ready: ');
+  // The speech weight at every animation frame from before speak() until it first reaches 1.
+  const weights = await page.evaluate(() => new Promise<number[]>((resolve) => {
+    const el = document.getElementById('b') as unknown as El & { stage: { view: { speechWeight: number } } };
+    const out: number[] = [];
+    const sample = () => {
+      out.push(el.stage.view.speechWeight);
+      if (out.at(-1)! >= 1 || out.length > 600) resolve(out);
+      else requestAnimationFrame(sample);
+    };
+    sample();
+    void el.speak('/examples/sample.wav');
+  }));
+  console.log(`speech weight per animation frame: ${weights.filter((w) => w > 0).map((w) => w.toFixed(2)).join(' ')}`);
+  expect(weights[0], 'at rest before speech').toBe(0);
+  expect(weights.at(-1), 'speaking').toBe(1);
+  expect(weights.filter((w) => w > 0 && w < 1).length, 'drawn part-way between the rest and speech').toBeGreaterThan(0);
+});

@@ -6,7 +6,7 @@
  * step of its loop, and plays the anim with frame k of the take at k / fps after the audio starts. The browser
  * page and the sync with audio playback: tests/e2e/talkinghead.spec.ts.
  */
-import { beforeAll, describe, expect, it } from 'vitest';
+import { afterEach, beforeAll, beforeEach, describe, expect, it, vi } from 'vitest';
 import * as THREE from 'three';
 import type { TalkingHead } from '@met4citizen/talkinghead';
 import { avatarUrl, talkingHeadInNode } from '../helpers/talkinghead';
@@ -27,6 +27,14 @@ function take(): Animation {
   return { fps: 30, frames: F, vertices: new Float32Array(0), pose: new Float32Array(F * 6), phones: new Uint8Array(F), tongue: new Float32Array(F), speech: new Float32Array(F), blendshapes: b };
 }
 
+/** performance.now() as the tests set it (ms): the driver blends a take in over its first 0.12 s. */
+let now = 0;
+beforeEach(() => {
+  now = 1000;
+  vi.spyOn(performance, 'now').mockImplementation(() => now);
+});
+afterEach(() => vi.restoreAllMocks());
+
 /** TalkingHead's morph-target state as showAvatar leaves it, for an avatar with these shapes. */
 function stateFor(names: readonly string[]) {
   const mt: Record<string, { realtime: number | null; needsUpdate: boolean }> = {};
@@ -40,6 +48,16 @@ describe('TalkingHeadDriver', () => {
     const driver = new TalkingHeadDriver(head);
     expect(driver.shapes).toEqual(TALKINGHEAD_SHAPES);
     expect(TALKINGHEAD_SHAPES).toHaveLength(52 - 8 - 2 - 1);
+    // The take blends in from what TalkingHead showed, over 0.12 s: no jump at its first frame.
+    Object.assign(head.mtAvatar.mouthRight, { value: 0.1 });
+    driver.show(take().blendshapes!, 10);
+    expect(head.mtAvatar.mouthRight.realtime).toBe(0.1);
+    expect(head.mtAvatar.jawOpen.realtime).toBe(0);
+    now += 60;
+    driver.show(take().blendshapes!, 10);
+    expect(head.mtAvatar.mouthRight.realtime).toBeCloseTo(0.3, 9);
+    expect(head.mtAvatar.jawOpen.realtime).toBeCloseTo(0.125, 9);
+    now += 60;
     driver.show(take().blendshapes!, 10);
     expect(head.mtAvatar.jawOpen).toEqual({ realtime: 0.25, needsUpdate: true });
     expect(head.mtAvatar.mouthRight.realtime).toBe(0.5);
@@ -50,7 +68,28 @@ describe('TalkingHeadDriver', () => {
     expect(head.mtAvatar.headRotateX.realtime).toBeCloseTo(-0.05, 3);
     expect(head.mtAvatar.bodyRotateX.realtime).toBeNull(); // TalkingHead's body sway stays
     driver.release();
-    for (const n of [...TALKINGHEAD_SHAPES, 'headRotateX', 'headRotateY', 'headRotateZ']) expect(head.mtAvatar[n]).toEqual({ realtime: null, needsUpdate: true });
+    for (const n of [...TALKINGHEAD_SHAPES, 'headRotateX', 'headRotateY', 'headRotateZ']) expect(head.mtAvatar[n]).toMatchObject({ realtime: null, needsUpdate: true });
+    // The next take blends in again.
+    driver.show(take().blendshapes!, 10);
+    expect(head.mtAvatar.jawOpen.realtime).toBe(0);
+  });
+
+  it('another avatar shown under a driver: the shapes it lacks are skipped, not a TypeError in TalkingHead\'s loop', () => {
+    const head = stateFor(ARKIT_NAMES);
+    const driver = new TalkingHeadDriver(head);
+    head.mtAvatar = stateFor(['jawOpen']).mtAvatar; // head.showAvatar(another) replaces the state
+    driver.show(take().blendshapes!, 10);
+    now += 200;
+    driver.show(take().blendshapes!, 10);
+    expect(head.mtAvatar.jawOpen.realtime).toBe(0.25);
+    expect(() => driver.release()).not.toThrow();
+    expect(head.mtAvatar.jawOpen.realtime).toBeNull();
+  });
+
+  it('a frame without weights says what to give', () => {
+    const driver = new TalkingHeadDriver(stateFor(ARKIT_NAMES));
+    expect(() => driver.showNamed(undefined as never)).toThrow(/blendshapes attribute/);
+    expect(() => driver.show(undefined as never, 0)).toThrow(/blendshapes: true/);
   });
 
   it('by name, as a frame event carries it; shapes the avatar lacks are listed, not set', () => {
@@ -58,6 +97,8 @@ describe('TalkingHeadDriver', () => {
     const driver = new TalkingHeadDriver(head, { head: false });
     expect(driver.shapes).toEqual(['jawOpen', 'mouthClose']);
     expect(driver.missing).toContain('mouthFunnel');
+    driver.showNamed({ jawOpen: 0.4, mouthClose: 0.1, mouthFunnel: 0.3 }, { yaw: 0.2, pitch: 0, roll: 0 });
+    now += 200;
     driver.showNamed({ jawOpen: 0.4, mouthClose: 0.1, mouthFunnel: 0.3 }, { yaw: 0.2, pitch: 0, roll: 0 });
     expect(head.mtAvatar.jawOpen.realtime).toBe(0.4);
     expect(head.mtAvatar.mouthFunnel).toBeUndefined();
@@ -127,6 +168,8 @@ describe('TalkingHead 1.7.0 itself (in Node) with the test avatars', () => {
     const b = take().blendshapes!;
     const driver = new TalkingHeadDriver(head);
     expect(driver.missing).toEqual([]);
+    driver.show(b, 0);
+    now += 200; // past the blend-in
     for (const f of [5, 20, 39]) {
       driver.show(b, f);
       step();
