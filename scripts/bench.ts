@@ -4,15 +4,12 @@
  * opens dev/bench.html, and writes docs/results/bench.json plus a table.
  * WebGPU here is SwiftShader (software): its figures are reported, not GPU figures.
  *
- *   npm run bench [-- --seconds 10,60 --backends cpu,webgpu]     (BENCH_PORT=... to serve on another port than 4191)
- *   npm run bench -- --render-only                                (only the head's render benchmark, merged into the existing bench.json)
- *   npm run bench -- --first-load-only                            (the first load alone, and onnxruntime alone, printed; nothing written)
- *   npm run bench -- --first-load-only --first-load-url URL       (... of a page served elsewhere, e.g. an older build)
+ *   npm run bench [-- OPTIONS]    (npm run bench -- --help lists them: USAGE below)
  */
 import { chromium } from '@playwright/test';
 import { spawn, execSync } from 'node:child_process';
-import { readFileSync, writeFileSync, mkdirSync } from 'node:fs';
-import { resolve } from 'node:path';
+import { existsSync, readFileSync, writeFileSync } from 'node:fs';
+import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
 import { checkManifest } from '../src/model/manifest';
 import { parseSafetensors } from '../src/model/safetensors';
@@ -22,17 +19,40 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
+import { portFree, positiveNumbers, readOptions, usageError, waitForServer } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
-const args = process.argv.slice(2);
-const opt = (name: string, fallback: string) => {
-  const i = args.indexOf(name);
-  return i >= 0 ? args[i + 1] : fallback;
-};
-const seconds = opt('--seconds', '10,60').split(',').map(Number);
-const backends = opt('--backends', 'cpu,webgpu').split(',');
+const USAGE = `npm run bench [-- OPTIONS]   the engine's speed and memory in headless Chromium -> docs/results/bench.json
+  --seconds 10,60          clip lengths to time (seconds, above 0)
+  --backends cpu,webgpu    decoders to time (cpu, webgpu)
+  --render-only            only the head's render benchmark, merged into the existing bench.json
+  --first-load-only        the first load alone, and onnxruntime alone, printed; nothing written
+  --first-load-url URL     with --first-load-only: of a page served elsewhere (e.g. an older build)
+  --node-only              the Node part alone (Mel, CPU decoders), printed; nothing written
+  --out FILE               write FILE instead of docs/results/bench.json (e.g. a reduced run's)
+  BENCH_PORT=N             serve the build on port N (default 4191; it must be free)`;
+const o = readOptions('bench', USAGE, {
+  seconds: { type: 'string', default: '10,60' }, backends: { type: 'string', default: 'cpu,webgpu' }, 'render-only': { type: 'boolean' },
+  'first-load-only': { type: 'boolean' }, 'first-load-url': { type: 'string' }, 'node-only': { type: 'boolean' }, out: { type: 'string' },
+});
+const OUT = resolve(ROOT, String(o.out ?? 'docs/results/bench.json'));
+if (!existsSync(dirname(OUT))) usageError('bench', USAGE, `--out ${o.out}: the folder ${dirname(OUT)} does not exist`);
+if (o['render-only'] && !existsSync(OUT)) usageError('bench', USAGE, `--render-only merges into ${OUT}, which does not exist: run the whole bench first`);
+const seconds = positiveNumbers(String(o.seconds)) ?? usageError('bench', USAGE, `--seconds takes clip lengths above 0, such as 10,60 (not ${o.seconds})`);
+const backends = String(o.backends).split(',');
+if (!backends.every((b) => b === 'cpu' || b === 'webgpu')) usageError('bench', USAGE, `--backends takes cpu and/or webgpu (not ${o.backends})`);
 const PORT = Number(process.env.BENCH_PORT ?? 4191);
-const renderOnly = args.includes('--render-only');
+if (!(Number.isInteger(PORT) && PORT > 0 && PORT < 65536)) usageError('bench', USAGE, `BENCH_PORT must be a port number (not ${process.env.BENCH_PORT})`);
+const renderOnly = Boolean(o['render-only']);
+const firstLoadOnly = Boolean(o['first-load-only']);
+if (o['first-load-url'] && !firstLoadOnly) usageError('bench', USAGE, '--first-load-url goes with --first-load-only (another page\'s figures are not written into bench.json)');
+if (renderOnly && firstLoadOnly) usageError('bench', USAGE, '--render-only and --first-load-only each run one part: give one');
+
+/** The machine as the figures were taken: the load average says how busy it was (other work slows every figure here). */
+async function machineState(t0: number): Promise<Record<string, unknown>> {
+  const os = await import('node:os');
+  return { cores: os.cpus().length, load_average: os.loadavg(), bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
+}
 
 /** The parts of the engine that run the same in Node (no Web Audio, no WebGPU): Mel and the CPU decoders. */
 async function nodeBench(): Promise<Record<string, number | string>> {
@@ -75,29 +95,22 @@ async function nodeBench(): Promise<Record<string, number | string>> {
 }
 
 async function main(): Promise<void> {
-  const firstLoadOnly = process.argv.includes('--first-load-only');
-  const node = firstLoadOnly ? {} : await nodeBench();
-  if (process.argv.includes('--node-only')) {
+  const node = firstLoadOnly || renderOnly ? {} : await nodeBench();
+  if (o['node-only']) {
     console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
     return;
   }
+  if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use (another server would be measured): free it, or set BENCH_PORT`);
   execSync('npm run --silent build:test', { cwd: ROOT, stdio: 'inherit' });
-  const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
+  const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
   try {
-    for (let i = 0; ; i++) {
-      try {
-        if ((await fetch(`http://127.0.0.1:${PORT}/dev/bench.html`)).ok) break;
-      } catch {
-        if (i > 100) throw new Error('the preview server did not start');
-        await new Promise((r) => setTimeout(r, 200));
-      }
-    }
+    await waitForServer(`http://127.0.0.1:${PORT}/dev/bench.html`, server);
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
-    const firstLoad = await measureFirstLoad(browser, opt('--first-load-url', `http://127.0.0.1:${PORT}/`), 5);
+    const firstLoad = renderOnly ? null : await measureFirstLoad(browser, String(o['first-load-url'] ?? `http://127.0.0.1:${PORT}/`), 5);
     // The floor under it: onnxruntime-web alone, started as the engine starts it (dev/ort-start.html).
-    await measureOnnxAlone(browser, `http://127.0.0.1:${PORT}/dev/ort-start.html`, firstLoad, 5);
+    if (firstLoad) await measureOnnxAlone(browser, `http://127.0.0.1:${PORT}/dev/ort-start.html`, firstLoad, 5);
     if (firstLoadOnly) {
-      printFirstLoad(firstLoad);
+      printFirstLoad(firstLoad!);
       await browser.close();
       return;
     }
@@ -115,20 +128,17 @@ async function main(): Promise<void> {
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
     if (renderOnly) {
       // Keep the engine's figures of the last full run; replace only the render benchmark's.
-      const file = resolve(ROOT, 'docs/results/bench.json');
-      const previous = JSON.parse(readFileSync(file, 'utf8')) as Record<string, unknown>;
-      writeFileSync(file, JSON.stringify({ ...previous, render: result.render }, null, 1) + '\n');
+      const previous = JSON.parse(readFileSync(OUT, 'utf8')) as Record<string, unknown>;
+      // The render figures carry the machine's state when they were taken (`machine` is the full run's).
+      writeFileSync(OUT, JSON.stringify({ ...previous, render: { ...(result.render as object), machine: await machineState(t0) } }, null, 1) + '\n');
       printRender(result.render as Record<string, number>);
-      console.log('written: docs/results/bench.json (render only)');
+      console.log(`written: ${OUT} (render only)`);
       return;
     }
     result.node = node;
     result.first_load = firstLoad;
-    const os = await import('node:os');
-    // The load average says how busy the machine was (other work slows every figure here).
-    result.machine = { cores: os.cpus().length, load_average: os.loadavg(), bench_seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() };
-    mkdirSync(resolve(ROOT, 'docs/results'), { recursive: true });
-    writeFileSync(resolve(ROOT, 'docs/results/bench.json'), JSON.stringify(result, null, 1) + '\n');
+    result.machine = await machineState(t0);
+    writeFileSync(OUT, JSON.stringify(result, null, 1) + '\n');
     print(result);
   } finally {
     try {
@@ -159,7 +169,7 @@ function print(r: Record<string, unknown>): void {
     `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel}, ${f(nd.decoder_latents_ms_per_frame, 2)} with its tokens made (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
   printRender(r.render as Record<string, number>);
   printFirstLoad(r.first_load as FirstLoad);
-  console.log('adapter:', JSON.stringify(r.adapter), '\nwritten: docs/results/bench.json');
+  console.log('adapter:', JSON.stringify(r.adapter), `\nwritten: ${OUT}`);
 }
 
 /** The head's render benchmark (dev/render-bench.ts): per frame, the main thread's work and the whole frame. */

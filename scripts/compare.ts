@@ -2,12 +2,12 @@
  * npm run compare: this project and in-browser lip-sync peers on the same test-split clips, in one headless
  * Chromium session (dev/compare.html), each run as its authors ship it; writes docs/results/peers.md and .json.
  *
- *   npm run compare [-- --corpus data/corpus --max-clips 80]
+ *   npm run compare [-- --corpus data/corpus --max-clips 80]       (npm run compare -- --help: the options, USAGE below)
  *   npm run compare -- --samples runs/reserved --out docs/results/peers-reserved
  *
- * Clips: the corpus's test split (unseen voices, sentences and faces) when it is built, else the three sample
- * clips in models/samples; with --samples DIR, the clips of DIR/index.json (models/samples' form: name, source, audio,
- * phones), such as the reserved recordings of real speakers (`scripts/py -m talkingface.train.reserved export DIR`).
+ * Clips: the corpus's test split (unseen voices, sentences and faces); with --samples DIR, the clips of
+ * DIR/index.json (models/samples' form: name, source, audio, phones), such as the reserved recordings of real
+ * speakers (`scripts/py -m talkingface.train.reserved export DIR`).
  * --out BASE writes BASE.md and BASE.json instead of docs/results/peers.*. The same segment measures for every system, each on the output it has:
  * - this project: the inner-lip gap (closed below 1 mm, open above 3 mm), as talkingface.train.evaluate;
  * - HeadAudio: its viseme at each 16 ms step (no event = sil): closed = PP, open = aa, O or E;
@@ -19,28 +19,31 @@
  */
 import { chromium } from '@playwright/test';
 import { spawn } from 'node:child_process';
+import { cpus, loadavg } from 'node:os';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
-import { resolve } from 'node:path';
+import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
 import { readWav16 } from '../tests/e2e/helpers/audio';
+import { portFree, readOptions, usageError, waitForServer } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
-function opt(name: string, fallback: string): string {
-  if (!args.includes(name)) return fallback;
-  const value = args[args.indexOf(name) + 1];
-  if (value === undefined || value.startsWith('--')) {
-    console.error(`compare: ${name} needs a value`);
-    process.exit(2);
-  }
-  return value;
-}
-const CORPUS = resolve(ROOT, opt('--corpus', 'data/corpus'));
+const USAGE = `npm run compare [-- OPTIONS]   this project and in-browser lip-sync peers on the same clips -> docs/results/peers.md/.json
+  --corpus DIR       the corpus whose test split is measured (default data/corpus)
+  --max-clips N      at most N clips (default 80 of the test split; a --samples folder whole)
+  --samples DIR      the clips of DIR/index.json instead (models/samples' form), e.g. the reserved recordings
+  --out BASE         write BASE.md and BASE.json (default docs/results/peers)
+  COMPARE_PORT=N     serve the pages on port N (default 4193; it must be free)`;
+const o = readOptions('compare', USAGE, { corpus: { type: 'string' }, 'max-clips': { type: 'string' }, samples: { type: 'string' }, out: { type: 'string' } });
+const CORPUS = resolve(ROOT, String(o.corpus ?? 'data/corpus'));
+if (o.corpus && !existsSync(resolve(CORPUS, 'splits.json'))) usageError('compare', USAGE, `--corpus ${o.corpus}: no corpus there (no splits.json; build one: scripts/py -m talkingface.corpus build)`);
 // The test split is cut to 80 clips unless told otherwise; a --samples folder is measured whole unless told otherwise.
-const MAX_CLIPS = Number(opt('--max-clips', args.includes('--samples') ? 'Infinity' : '80'));
-const SAMPLES = args.includes('--samples') ? resolve(ROOT, opt('--samples', '')) : null;
-const OUT = resolve(ROOT, opt('--out', 'docs/results/peers'));
-const PORT = 4193;
+const MAX_CLIPS = o['max-clips'] === undefined ? (o.samples ? Infinity : 80) : Number(o['max-clips']);
+if (!(Number.isInteger(MAX_CLIPS) && MAX_CLIPS > 0) && MAX_CLIPS !== Infinity) usageError('compare', USAGE, `--max-clips takes a whole number above 0 (not ${o['max-clips']})`);
+const SAMPLES = o.samples ? resolve(ROOT, String(o.samples)) : null;
+const OUT = resolve(ROOT, String(o.out ?? 'docs/results/peers'));
+if (!existsSync(dirname(OUT))) usageError('compare', USAGE, `--out ${o.out}: the folder ${dirname(OUT)} does not exist`);
+const PORT = Number(process.env.COMPARE_PORT ?? 4193);
 const BILABIALS = new Set(['P', 'B', 'M']);
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']); // corpus/checks.py OPEN_VOWELS
 const HA_NAMES = ['aa', 'E', 'I', 'O', 'U', 'PP', 'SS', 'TH', 'DD', 'FF', 'kk', 'nn', 'RR', 'CH', 'sil'];
@@ -95,7 +98,9 @@ function loadClips(): { clips: Clip[]; from: string } {
       }),
     };
   }
-  return loadSamples(resolve(ROOT, 'models/samples'), `sample clips in models/samples (no corpus at ${CORPUS})`);
+  // Not the three sample clips in its place: their figures would replace the test split's in docs/results/peers.md.
+  return usageError('compare', USAGE, `no corpus at ${CORPUS} (build it: scripts/py -m talkingface.corpus build --preset full --seed 0 --out data/corpus), ` +
+    'or measure the sample clips elsewhere: --samples models/samples --out runs/peers-samples');
 }
 
 /** Output frames of a system whose frame k shows t = k * step (+ offset) that fall in [a, b); the nearest if none. */
@@ -133,16 +138,14 @@ function roll<T>(x: T[], by: number): T[] {
 
 async function main() {
   const { clips, from } = loadClips();
-  const server = spawn('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
+  if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use (another server would answer): free it, or set COMPARE_PORT`);
+  const server = spawn('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
   const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: CHROMIUM_ARGS });
+  const t0 = Date.now();
   try {
     const page = await browser.newPage();
-    for (let i = 0; ; i++) {
-      try { await page.goto(`http://127.0.0.1:${PORT}/dev/compare.html`); break; } catch (e) {
-        if (i > 120) throw new Error(`the dev server did not start: ${(e as Error).message}`);
-        await new Promise((r) => setTimeout(r, 500));
-      }
-    }
+    await waitForServer(`http://127.0.0.1:${PORT}/dev/compare.html`, server, 120);
+    await page.goto(`http://127.0.0.1:${PORT}/dev/compare.html`);
     await page.waitForFunction(() => (globalThis as unknown as { compare?: unknown }).compare, null, { timeout: 120_000 });
     const info = await page.evaluate(() => {
       const c = (globalThis as unknown as { compare: { error?: string; lookAheadMs: number; fps: number; backend: string } }).compare;
@@ -199,6 +202,8 @@ async function main() {
     });
     const result = {
       clips: from, audio_seconds: cost.seconds, backend: info.backend,
+      // Costs are of this machine as it was: the load average says how busy (other work slows every system alike).
+      machine: { cores: cpus().length, load_average: loadavg(), browser: browser.version(), seconds: (Date.now() - t0) / 1000, date: new Date().toISOString() },
       systems: {
         'talking-face (this project)': {
           output: 'inner-lip gap per 1/30 s frame', all: summary(groups.all.ours, groups.all.oursChance),
@@ -234,7 +239,7 @@ async function main() {
   }
 }
 
-function markdown(r: { clips: string; audio_seconds: number; systems: Record<string, { output: string; all: Record<string, number>; human: Record<string, number>; ms_per_audio_second: number; algorithmic_latency_ms: number; latency_note: string }>; not_run: Record<string, string> }): string {
+function markdown(r: { clips: string; audio_seconds: number; machine: { cores: number; load_average: number[]; date: string }; systems: Record<string, { output: string; all: Record<string, number>; human: Record<string, number>; ms_per_audio_second: number; algorithmic_latency_ms: number; latency_note: string }>; not_run: Record<string, string> }): string {
   const pct = (x: number) => `${(100 * x).toFixed(1)}%`;
   const rows: string[] = [];
   for (const [name, s] of Object.entries(r.systems)) {
@@ -251,7 +256,7 @@ function markdown(r: { clips: string; audio_seconds: number; systems: Record<str
     'Closed: the mouth closed (our gap < 1 mm; HeadAudio\'s PP viseme) at one or more output frames of a /p b m/ segment; false: the same in',
     'other speech segments; chance: the same output shifted in time against the phones. Open: an open vowel (80 ms or more) with the mouth',
     'open (gap > 3 mm; aa, E or O). Rest: pauses of 0.3 s or more at rest on most of their frames (gap < 1 mm; sil or no viseme).',
-    'Cost: milliseconds of compute per second of audio on this 2-core machine. Latency: algorithmic, ms of audio needed after an instant.', '',
+    `Cost: milliseconds of compute per second of audio on ${r.machine.cores} cores (load average ${r.machine.load_average.map((x) => x.toFixed(1)).join(', ')}; ${r.machine.date.slice(0, 10)}), all systems in turn in one run: compare them as ratios. Latency: algorithmic, ms of audio needed after an instant.`, '',
     '| system | clips | /p b m/ | closed / false / chance | open vowels opened | pauses at rest | cost (ms per s) | latency (ms) |',
     '| --- | --- | --- | --- | --- | --- | --- | --- |', ...rows, '',
     ...Object.entries(r.systems).map(([n, s]) => `- ${n}: ${s.output}; latency: ${s.latency_note}.`),

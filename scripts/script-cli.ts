@@ -1,0 +1,71 @@
+/**
+ * What the project's measuring scripts (bench, compare) share on the command line and around their servers: options
+ * read strictly (an unknown option, a missing value or a bad number is an error with the usage, before any work and
+ * before any result is written), --help, a port checked free before anything is built, and a server waited for
+ * that says why it did not start.
+ */
+import { parseArgs } from 'node:util';
+import { createServer } from 'node:net';
+import type { ChildProcess } from 'node:child_process';
+
+export type Options = Record<string, { type: 'string' | 'boolean'; default?: string | boolean }>;
+export type Values = Record<string, string | boolean | undefined>;
+
+/** The options given, or exit: 0 after printing `usage` for --help, 2 with what is wrong and the usage. */
+export function readOptions(script: string, usage: string, options: Options, argv = process.argv.slice(2)): Values {
+  try {
+    const { values } = parseArgs({ args: argv, options: { ...options, help: { type: 'boolean', short: 'h' } }, strict: true, allowPositionals: false });
+    if (values.help) {
+      console.log(usage);
+      process.exit(0);
+    }
+    return values as Values;
+  } catch (e) {
+    return usageError(script, usage, (e as Error).message);
+  }
+}
+
+/** Exit 2 saying what is wrong with the command line, and how to use it. */
+export function usageError(script: string, usage: string, message: string): never {
+  console.error(`${script}: ${message}\n\n${usage}`);
+  process.exit(2);
+}
+
+/** A comma-separated list of numbers above zero ("10,60"), or null saying nothing valid was given. */
+export function positiveNumbers(text: string): number[] | null {
+  const xs = text.split(',').map((s) => Number(s.trim()));
+  return xs.length > 0 && xs.every((x) => Number.isFinite(x) && x > 0) ? xs : null;
+}
+
+/** Whether nothing listens on `port` of 127.0.0.1 (a server there would be measured instead of ours). */
+export function portFree(port: number): Promise<boolean> {
+  return new Promise((resolve) => {
+    const probe = createServer();
+    probe.once('error', () => resolve(false));
+    probe.listen(port, '127.0.0.1', () => probe.close(() => resolve(true)));
+  });
+}
+
+/**
+ * Resolve once `url` answers 200 from `server`; reject saying why if the server exits first (its last output) or
+ * does not answer within `seconds`.
+ */
+export async function waitForServer(url: string, server: ChildProcess, seconds = 60): Promise<void> {
+  let output = '';
+  server.stdout?.on('data', (d: Buffer) => (output = (output + d.toString()).slice(-2000)));
+  server.stderr?.on('data', (d: Buffer) => (output = (output + d.toString()).slice(-2000)));
+  let exited: number | null = null;
+  server.once('exit', (code) => (exited = code ?? -1));
+  const deadline = Date.now() + seconds * 1000;
+  for (let last = ''; ; await new Promise((r) => setTimeout(r, 250))) {
+    if (exited !== null) throw new Error(`the server for ${url} exited (code ${exited}) before it answered:\n${output.trim()}`);
+    try {
+      const res = await fetch(url);
+      if (res.ok) return;
+      last = `HTTP ${res.status}`;
+    } catch (e) {
+      last = (e as Error).message;
+    }
+    if (Date.now() > deadline) throw new Error(`${url} did not answer within ${seconds} s (last: ${last})${output ? `:\n${output.trim()}` : ''}`);
+  }
+}
