@@ -7,7 +7,7 @@
  *   npm run bench [-- OPTIONS]    (npm run bench -- --help lists them: USAGE below)
  */
 import { chromium } from '@playwright/test';
-import { spawn, execSync } from 'node:child_process';
+import { execSync } from 'node:child_process';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
@@ -19,7 +19,7 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
-import { portFree, positiveNumbers, readOptions, usageError, waitForServer } from './script-cli';
+import { portFree, positiveNumbers, readOptions, startServer, usageError } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const USAGE = `npm run bench [-- OPTIONS]   the engine's speed and memory in headless Chromium -> docs/results/bench.json
@@ -102,9 +102,9 @@ async function main(): Promise<void> {
   }
   if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use (another server would be measured): free it, or set BENCH_PORT`);
   execSync('npm run --silent build:test', { cwd: ROOT, stdio: 'inherit' });
-  const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
+  const server = startServer('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], ROOT);
   try {
-    await waitForServer(`http://127.0.0.1:${PORT}/dev/bench.html`, server);
+    await server.ready(`http://127.0.0.1:${PORT}/dev/bench.html`);
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
     const firstLoad = renderOnly ? null : await measureFirstLoad(browser, String(o['first-load-url'] ?? `http://127.0.0.1:${PORT}/`), 5);
     // The floor under it: onnxruntime-web alone, started as the engine starts it (dev/ort-start.html).
@@ -141,11 +141,7 @@ async function main(): Promise<void> {
     writeFileSync(OUT, JSON.stringify(result, null, 1) + '\n');
     print(result);
   } finally {
-    try {
-      process.kill(-server.pid!);
-    } catch {
-      /* already gone */
-    }
+    server.stop();
   }
 }
 

@@ -18,25 +18,26 @@
  * phones. Latency is algorithmic: how much audio after an instant each system needs before it shows that instant.
  */
 import { chromium } from '@playwright/test';
-import { spawn } from 'node:child_process';
 import { cpus, loadavg } from 'node:os';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
 import { readWav16 } from '../tests/e2e/helpers/audio';
-import { portFree, readOptions, usageError, waitForServer } from './script-cli';
+import { portFree, readOptions, startServer, usageError } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
 const USAGE = `npm run compare [-- OPTIONS]   this project and in-browser lip-sync peers on the same clips -> docs/results/peers.md/.json
   --corpus DIR       the corpus whose test split is measured (default data/corpus)
   --max-clips N      at most N clips (default 80 of the test split; a --samples folder whole)
-  --samples DIR      the clips of DIR/index.json instead (models/samples' form), e.g. the reserved recordings
+  --samples DIR      the clips of DIR/index.json instead (models/samples' form), e.g. the reserved recordings;
+                     with --out
   --out BASE         write BASE.md and BASE.json (default docs/results/peers)
   COMPARE_PORT=N     serve the pages on port N (default 4193; it must be free)`;
 const o = readOptions('compare', USAGE, { corpus: { type: 'string' }, 'max-clips': { type: 'string' }, samples: { type: 'string' }, out: { type: 'string' } });
 const CORPUS = resolve(ROOT, String(o.corpus ?? 'data/corpus'));
-if (o.corpus && !existsSync(resolve(CORPUS, 'splits.json'))) usageError('compare', USAGE, `--corpus ${o.corpus}: no corpus there (no splits.json; build one: scripts/py -m talkingface.corpus build)`);
+if (o.samples && !o.out) usageError('compare', USAGE, '--samples needs --out: the default, docs/results/peers, holds the test split\'s figures');
+if (o.corpus && !o.samples && !existsSync(resolve(CORPUS, 'splits.json'))) usageError('compare', USAGE, `--corpus ${o.corpus}: no corpus there (no splits.json; build one: scripts/py -m talkingface.corpus build)`);
 // The test split is cut to 80 clips unless told otherwise; a --samples folder is measured whole unless told otherwise.
 const MAX_CLIPS = o['max-clips'] === undefined ? (o.samples ? Infinity : 80) : Number(o['max-clips']);
 if (!(Number.isInteger(MAX_CLIPS) && MAX_CLIPS > 0) && MAX_CLIPS !== Infinity) usageError('compare', USAGE, `--max-clips takes a whole number above 0 (not ${o['max-clips']})`);
@@ -44,6 +45,7 @@ const SAMPLES = o.samples ? resolve(ROOT, String(o.samples)) : null;
 const OUT = resolve(ROOT, String(o.out ?? 'docs/results/peers'));
 if (!existsSync(dirname(OUT))) usageError('compare', USAGE, `--out ${o.out}: the folder ${dirname(OUT)} does not exist`);
 const PORT = Number(process.env.COMPARE_PORT ?? 4193);
+if (!(Number.isInteger(PORT) && PORT > 0 && PORT < 65536)) usageError('compare', USAGE, `COMPARE_PORT must be a port number (not ${process.env.COMPARE_PORT})`);
 const BILABIALS = new Set(['P', 'B', 'M']);
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']); // corpus/checks.py OPEN_VOWELS
 const HA_NAMES = ['aa', 'E', 'I', 'O', 'U', 'PP', 'SS', 'TH', 'DD', 'FF', 'kk', 'nn', 'RR', 'CH', 'sil'];
@@ -139,12 +141,17 @@ function roll<T>(x: T[], by: number): T[] {
 async function main() {
   const { clips, from } = loadClips();
   if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use (another server would answer): free it, or set COMPARE_PORT`);
-  const server = spawn('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
+  const server = startServer('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], ROOT);
+  try {
+    await server.ready(`http://127.0.0.1:${PORT}/dev/compare.html`, 120);
+  } catch (e) {
+    server.stop();
+    throw e;
+  }
   const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: CHROMIUM_ARGS });
   const t0 = Date.now();
   try {
     const page = await browser.newPage();
-    await waitForServer(`http://127.0.0.1:${PORT}/dev/compare.html`, server, 120);
     await page.goto(`http://127.0.0.1:${PORT}/dev/compare.html`);
     await page.waitForFunction(() => (globalThis as unknown as { compare?: unknown }).compare, null, { timeout: 120_000 });
     const info = await page.evaluate(() => {
@@ -235,7 +242,7 @@ async function main() {
     console.log(markdown(result));
   } finally {
     await browser.close();
-    try { process.kill(-server.pid!); } catch { /* the server is already gone */ }
+    server.stop();
   }
 }
 

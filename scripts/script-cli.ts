@@ -6,7 +6,7 @@
  */
 import { parseArgs } from 'node:util';
 import { createServer } from 'node:net';
-import type { ChildProcess } from 'node:child_process';
+import { spawn } from 'node:child_process';
 
 export type Options = Record<string, { type: 'string' | 'boolean'; default?: string | boolean }>;
 export type Values = Record<string, string | boolean | undefined>;
@@ -46,26 +46,42 @@ export function portFree(port: number): Promise<boolean> {
   });
 }
 
-/**
- * Resolve once `url` answers 200 from `server`; reject saying why if the server exits first (its last output) or
- * does not answer within `seconds`.
- */
-export async function waitForServer(url: string, server: ChildProcess, seconds = 60): Promise<void> {
+/** A server started for a script: its output and exit are followed from the start (a quick exit is not missed). */
+export interface Server {
+  /** Resolve once `url` answers 200; reject saying why if the server has exited (its last output) or does not answer within `seconds`. */
+  ready(url: string, seconds?: number): Promise<void>;
+  /** Stop it and whatever it started. */
+  stop(): void;
+}
+
+export function startServer(command: string, args: string[], cwd: string): Server {
+  const child = spawn(command, args, { cwd, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
   let output = '';
-  server.stdout?.on('data', (d: Buffer) => (output = (output + d.toString()).slice(-2000)));
-  server.stderr?.on('data', (d: Buffer) => (output = (output + d.toString()).slice(-2000)));
-  let exited: number | null = null;
-  server.once('exit', (code) => (exited = code ?? -1));
-  const deadline = Date.now() + seconds * 1000;
-  for (let last = ''; ; await new Promise((r) => setTimeout(r, 250))) {
-    if (exited !== null) throw new Error(`the server for ${url} exited (code ${exited}) before it answered:\n${output.trim()}`);
-    try {
-      const res = await fetch(url);
-      if (res.ok) return;
-      last = `HTTP ${res.status}`;
-    } catch (e) {
-      last = (e as Error).message;
-    }
-    if (Date.now() > deadline) throw new Error(`${url} did not answer within ${seconds} s (last: ${last})${output ? `:\n${output.trim()}` : ''}`);
-  }
+  const keep = (d: Buffer) => (output = (output + d.toString()).slice(-2000));
+  child.stdout.on('data', keep);
+  child.stderr.on('data', keep);
+  const exited = () => child.exitCode ?? child.signalCode;
+  return {
+    async ready(url: string, seconds = 60): Promise<void> {
+      const deadline = Date.now() + seconds * 1000;
+      for (let last = ''; ; await new Promise((r) => setTimeout(r, 250))) {
+        if (exited() !== null) throw new Error(`the server for ${url} exited (${exited()}) before it answered:\n${output.trim()}`);
+        try {
+          const res = await fetch(url);
+          if (res.ok) return;
+          last = `HTTP ${res.status}`;
+        } catch (e) {
+          last = (e as Error).message;
+        }
+        if (Date.now() > deadline) throw new Error(`${url} did not answer within ${seconds} s (last: ${last})${output ? `:\n${output.trim()}` : ''}`);
+      }
+    },
+    stop(): void {
+      try {
+        process.kill(-child.pid!);
+      } catch {
+        /* already gone */
+      }
+    },
+  };
 }

@@ -238,7 +238,7 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
     recording = r;
     refreshControls();
     ui.recordButton.textContent = 'Stop recording';
-    ui.recordButton.setAttribute('aria-pressed', 'true');
+    ui.recordButton.classList.add('recording'); // its label says the state: no aria-pressed beside it
     document.body.dataset.recording = 'true';
     tell('Recording: the face follows your voice. Press Stop recording or Escape to stop.');
     const update = () => {
@@ -256,7 +256,7 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
 async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> {
   [recording, finishing] = [null, true];
   ui.recordButton.textContent = 'Record';
-  ui.recordButton.setAttribute('aria-pressed', 'false');
+  ui.recordButton.classList.remove('recording');
   tell('Recording stopped; finishing the take…');
   try {
     const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));

@@ -106,7 +106,8 @@ export class TakeView {
       const ring = (this.lipRing ??= lipOutline(this.view.template));
       const upper = this.view.template.regions.lips_outer_upper;
       const i = ring.indexOf(this.picked ?? upper[Math.floor(upper.length / 2)]); // the default shown (paint.ts)
-      v = ring[(Math.max(i, 0) + at + ring.length) % ring.length] ?? null;
+      // From a vertex off the outline (a click elsewhere), ] goes to the outline's first vertex and [ to its last.
+      v = ring[i < 0 ? (at > 0 ? 0 : ring.length - 1) : (i + at + ring.length) % ring.length] ?? null;
     } else v = this.view.pickVertex(at.x, at.y);
     if (v !== null) this.picked = v;
     return v !== null;

@@ -148,6 +148,8 @@ export interface CaptureOptions {
 
 /** How long a suspended context is given to resume before the capture says it was interrupted. */
 const RESUME_WAIT_MS = 1000;
+/** How often the stream's tracks are looked at (a track a script stops fires no event). */
+const TRACK_POLL_MS = 500;
 
 /** A running capture: stop() releases the worklet, the context and (if asked) the stream's tracks. */
 export class AudioCapture {
@@ -246,15 +248,19 @@ export class AudioCapture {
       ev.track.addEventListener('ended', gone);
     };
     const suspended = () => {
+      if (context.state === 'running' && live()) said = false; // sound again: a later loss is reported too
       if (this.stopped || context.state === 'running' || context.state === 'closed') return;
       void context.resume().catch(() => undefined); // deliberate: whether it ran is read below
       setTimeout(() => context.state !== 'running' && say('the browser suspended the audio (another application took it, or the page was put aside)'), RESUME_WAIT_MS);
     };
     for (const t of stream.getAudioTracks()) t.addEventListener('ended', gone);
+    // A track stopped by a script ends without an 'ended' event: its state is read too.
+    const poll = setInterval(gone, TRACK_POLL_MS);
     stream.addEventListener('removetrack', gone);
     stream.addEventListener('addtrack', added);
     context.addEventListener('statechange', suspended);
     this.unwatch = () => {
+      clearInterval(poll);
       for (const t of stream.getAudioTracks()) t.removeEventListener('ended', gone);
       stream.removeEventListener('removetrack', gone);
       stream.removeEventListener('addtrack', added);

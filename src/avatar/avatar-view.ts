@@ -111,7 +111,6 @@ export class AvatarView {
   setBlendshapes(b: BlendshapeFrames, frame: number): void {
     this.shown.arkit.set(b.arkit.subarray(frame * ARKIT_NAMES.length, (frame + 1) * ARKIT_NAMES.length));
     this.shown.visemes.set(b.visemes.subarray(frame * VISEME_NAMES.length, (frame + 1) * VISEME_NAMES.length));
-    this.target = 1;
     if (this.speech >= 1) this.avatar.setWeights(b.arkit, frame * ARKIT_NAMES.length, b.visemes, frame * VISEME_NAMES.length);
     else this.blend();
     this.requestRender();

@@ -195,6 +195,7 @@ export class TalkingFaceElement extends HTMLElement {
         blendshapes: this.blendshapes, headMotionScale: this.headMotionScale });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
+      if (gen !== this.generation) return; // stopped meanwhile: not a failure
       throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
     }
     if (gen !== this.generation) { // stopped while the capture started

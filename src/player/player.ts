@@ -232,6 +232,7 @@ export class Player {
 
   /** Stop playback (the face keeps the frame it shows). */
   stop(): void {
+    this.liveQuiet = LIVE_REST_FRAMES; // a live session after this starts at rest, whatever the last one ended on
     const p = this.playing;
     if (!p) return;
     this.playing = null;

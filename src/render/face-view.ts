@@ -52,7 +52,7 @@ export class FaceView {
   readonly model: Head;
   /** Everything that moves with the head pose T_p. */
   readonly head: THREE.Group;
-  /** The last idle state drawn (null without life). */
+  /** The last idle state drawn (null without life, and while it is held still: the eyes open and ahead, at rest). */
   idleState: IdleState | null = null;
   private readonly idle: IdleMotion | null;
   private lifePaused: boolean;
@@ -127,7 +127,10 @@ export class FaceView {
   readonly drawn: Promise<void>;
   private onDrawn: (() => void) | null = null;
 
-  /** Pause (true) or resume (false) the breathing, blinks and eye movements; a paused face is drawn only when it changes. */
+  /**
+   * Pause (true) or resume (false) the breathing, blinks and eye movements: paused, the face goes to its idle rest (eyes
+   * open, looking ahead) and is drawn only when it changes.
+   */
   setLifePaused(paused: boolean): void {
     this.lifePaused = paused;
   }
@@ -167,6 +170,9 @@ export class FaceView {
 
   /** Blend speech in (the frames given are shown) or out (back to the rest face), over a fraction of a second. */
   setSpeaking(on: boolean): void {
+    // The blend's clock starts now: with the life held still (paused, reduced motion) the loop has not updated it,
+    // and a step as long as the stillness would make the blend one jump.
+    if (this.speechTarget !== (on ? 1 : 0)) this.lastTime = -1;
     this.speechTarget = on ? 1 : 0;
     this.requestRender();
   }

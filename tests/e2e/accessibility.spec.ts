@@ -84,6 +84,22 @@ test('reduced motion holds the demo face at rest still; on a phone the status li
   const idle = () => page.evaluate(() => (globalThis as unknown as { talkingFace: { view: { idleState: unknown } } }).talkingFace.view.idleState);
   await page.waitForTimeout(1500);
   expect(await idle(), 'no breathing, blinks or eye movements').toBeNull();
+  // Held still for a while, speech still blends in over 0.12 s: no faster than 1 per 0.12 s, not one jump after the
+  // stillness (the view and this sampler run in either order within a frame: the bound runs from the frame before).
+  const sampled = page.evaluate(() => new Promise<[number, number][]>((resolve) => {
+    const view = (globalThis as unknown as { talkingFace: { view: { speechWeight: number } } }).talkingFace.view;
+    const out: [number, number][] = [];
+    const sample = () => {
+      out.push([performance.now(), view.speechWeight]);
+      if (out.at(-1)![1] >= 1 || out.length > 3000) resolve(out);
+      else requestAnimationFrame(sample);
+    };
+    sample();
+  }));
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  const w = await sampled;
+  expect(w.at(-1)![1], 'speaking').toBe(1);
+  for (let i = 1; i < w.length; i++) expect(w[i][1] - w[i - 1][1], `rise at ${w[i][0].toFixed(0)} ms`).toBeLessThanOrEqual((w[i][0] - w[Math.max(0, i - 2)][0] + 5) / 120);
   await page.emulateMedia({ reducedMotion: 'no-preference' });
   await expect.poll(idle, { timeout: 10_000 }).not.toBeNull();
 
@@ -136,5 +152,6 @@ test('<talking-face>: the face turns and zooms by keyboard; screen readers hear 
   const ax = await page.locator('#left').ariaSnapshot();
   expect(ax, 'the announcer stays in the accessibility tree under hide-status').toContain('status');
   const spoke = Object.keys(await liveChanges(page));
+  // The page's own live regions (the element's are in its shadow root, watched above): the frame counters are not.
   expect(spoke.filter((k) => k !== 'log'), 'no live region of the page but its event log').toEqual([]);
 });

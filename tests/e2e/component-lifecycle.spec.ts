@@ -127,7 +127,9 @@ test('an element moved in the page draws again, without WebGL errors', async ({ 
   await page.evaluate(() => document.body.append(document.getElementById('left')!));
   await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(2);
   await page.locator('#speak').click();
-  await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(10);
+  // Played to its end (frames come at the page's frame rate: a few a second on a loaded machine with software WebGL).
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'ended').length ?? 0, { timeout: 60_000 }).toBe(1);
+  expect((await events()).left?.filter((e) => e === 'frame:playback').length).toBeGreaterThan(2);
   const stats = await imageStats(page, await page.locator('#left').screenshot());
   expect(stats.foregroundFraction, 'the moved face is drawn').toBeGreaterThan(0.1);
   expect(gl, 'WebGL messages').toEqual([]);

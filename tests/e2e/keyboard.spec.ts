@@ -97,18 +97,18 @@ test('open, play, pause, scrub, orbit, zoom, step, record, stop and export by ke
   await tabTo(page, '#record-button');
   await page.keyboard.press('Enter');
   await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
-  await expect(page.locator('#record-button')).toHaveAttribute('aria-pressed', 'true');
+  await expect(page.locator('#record-button')).toHaveClass(/recording/);
   await expect(page.locator('#record-button')).toBeFocused();
   await page.waitForTimeout(1500);
   await page.keyboard.press('Space');
   await expect(page.locator('#clip-info')).toContainText('Recording', { timeout: 60_000 });
-  await expect(page.locator('#record-button')).toHaveAttribute('aria-pressed', 'false');
+  await expect(page.locator('#record-button')).not.toHaveClass(/recording/);
   await expect(page.locator('#record-button')).toBeFocused();
   await page.keyboard.press('Enter');
-  await expect(page.locator('#record-button')).toHaveAttribute('aria-pressed', 'true', { timeout: 20_000 });
+  await expect(page.locator('#record-button')).toHaveClass(/recording/, { timeout: 20_000 });
   await page.waitForTimeout(1000);
   await page.keyboard.press('Escape');
-  await expect(page.locator('#record-button')).toHaveAttribute('aria-pressed', 'false');
+  await expect(page.locator('#record-button')).not.toHaveClass(/recording/);
   await expect(page.locator('#status')).toContainText('Recording is ready', { timeout: 60_000 });
 
   // Export: Enter on "Export .glb" downloads the take.
