@@ -82,7 +82,8 @@ export class AvatarView {
   /** Fetch, parse and show the avatar at `url` (AvatarLoadError says what is wrong with it). */
   static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null): Promise<AvatarView> {
     const res = await fetch(url).catch((e: Error) => {
-      throw new Error(`could not fetch the avatar ${url}: ${e.message}`);
+      const other = new URL(url, location.href).origin !== location.origin;
+      throw new Error(`could not fetch the avatar ${url}: ${e.message}${other ? ' (another origin: does it send CORS headers?)' : ''}`);
     });
     if (!res.ok) throw new Error(`could not fetch the avatar ${url}: HTTP ${res.status}`);
     return new AvatarView(canvas, await GltfAvatar.parse(await res.arrayBuffer(), url, headBone));

@@ -21,6 +21,14 @@ export function headMotionAttribute(value: string | null): number | undefined {
   return undefined;
 }
 
+/**
+ * What the attributes ask of each animation or live session: ARKit weights and visemes with an avatar or when the
+ * page asks (`blendshapes`); the head's own motion's scale (`head-motion`), read at each speak() and startMicrophone().
+ */
+export function frameOptions(el: Element): { blendshapes: boolean; headMotionScale: number | undefined } {
+  return { blendshapes: el.hasAttribute('avatar') || el.hasAttribute('blendshapes'), headMotionScale: headMotionAttribute(el.getAttribute('head-motion')) };
+}
+
 /** speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is another origin's). */
 export async function audioInput(audio: Blob | AudioBuffer | URL | string): Promise<Blob | AudioBuffer> {
   if (!(typeof audio === 'string' || audio instanceof URL)) return audio;

@@ -13,7 +13,7 @@ import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { decodeAudio, raiseIfQuiet } from '../audio/decode';
-import { audioInput, backendAttribute, headMotionAttribute } from './attributes';
+import { audioInput, backendAttribute, frameOptions } from './attributes';
 import { shadowParts } from './parts';
 import { ElementStage } from './stage';
 import { openMicrophone } from '../audio/capture';
@@ -43,6 +43,7 @@ export class TalkingFaceElement extends HTMLElement {
   private work: AbortController | null = null; // the speak() or startMicrophone() under way: stop() aborts it
   private playingStatus = '';
   private connected = false; // connectedCallback has run once
+  private retrying = false; // the last load failed: the next to succeed shows the face itself
 
   constructor() {
     super();
@@ -77,7 +78,7 @@ export class TalkingFaceElement extends HTMLElement {
   }
 
   connectedCallback(): void {
-    this.connected = true;
+    [this.connected, this.retrying] = [true, false]; // this call shows the face once loaded
     void this.load().then(
       () => this.afterLoad(),
       () => undefined, // deliberate: load() has already reported the failure (status line and `error` event)
@@ -97,7 +98,7 @@ export class TalkingFaceElement extends HTMLElement {
       // (the others keep theirs) and keeps its view (and does not autoplay again); `ready` tells the new backend.
       const anew = name !== 'backend';
       this.stop();
-      [this.loading, this.engine] = [null, null];
+      [this.loading, this.engine, this.retrying] = [null, null, false];
       if (anew) this.stage.drop();
       void this.load().then(() => this.afterLoad(anew), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value && this.engine) {
@@ -134,8 +135,7 @@ export class TalkingFaceElement extends HTMLElement {
     try {
       animation = await engine.animate(quiet.samples, {
         unposed: true,
-        blendshapes: this.blendshapes,
-        headMotionScale: this.headMotionScale,
+        ...frameOptions(this),
         signal,
         onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`, false, false),
       });
@@ -192,7 +192,7 @@ export class TalkingFaceElement extends HTMLElement {
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream.latency?.lastMs) }));
       }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
         onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),
-        blendshapes: this.blendshapes, headMotionScale: this.headMotionScale });
+        ...frameOptions(this) });
     } catch (e) {
       for (const t of media.getTracks()) t.stop();
       if (gen !== this.generation) return; // stopped meanwhile: not a failure
@@ -243,10 +243,13 @@ export class TalkingFaceElement extends HTMLElement {
       this.loading = sharedEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))).then(
         (engine) => {
           this.engine = engine;
+          // A retry (speak() or startMicrophone() after a failed load): no connectedCallback will show the face.
+          if (this.retrying) void this.afterLoad(false, false);
+          this.retrying = false;
           return engine;
         },
         (e: Error) => {
-          this.loading = null; // a later call retries
+          [this.loading, this.retrying] = [null, true]; // a later call retries
           throw this.fail('model', `the model could not be loaded: ${e.message}`);
         },
       );
@@ -254,22 +257,16 @@ export class TalkingFaceElement extends HTMLElement {
     return this.loading;
   }
 
-  /** Frames carry ARKit weights and visemes with an avatar, or when the page asks. */
-  private get blendshapes(): boolean {
-    return this.hasAttribute('avatar') || this.hasAttribute('blendshapes');
-  }
-
-  /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
-  private get headMotionScale(): number | undefined {
-    return headMotionAttribute(this.getAttribute('head-motion'));
-  }
-
-  /** Show the face and say ready; then follow the microphone (`live`), or speak `src` (`autoplay`, unless `autoplay` is false). */
-  private async afterLoad(autoplay = true): Promise<void> {
+  /**
+   * Show the face and say ready; then follow the microphone (`live`), or speak `src` (`autoplay`, unless `autoplay` is
+   * false); `start` false: neither (a speak() or startMicrophone() that retried a failed load is under way).
+   */
+  private async afterLoad(autoplay = true, start = true): Promise<void> {
     const engine = this.engine;
     if (!engine || !this.isConnected) return; // removed (or reloading) while the model loaded: nothing to show or start
     if (!this.stage.view) {
       const avatar = this.getAttribute('avatar');
+      if (avatar) this.setStatus('Loading the avatar…');
       try {
         if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, this.getAttribute('avatar-head-bone')))) return; // superseded
       } catch (e) {
@@ -290,6 +287,7 @@ export class TalkingFaceElement extends HTMLElement {
     }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
+    if (!start) return;
     if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined); // reported by fail()
     else if (autoplay && src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined); // reported by fail()
   }

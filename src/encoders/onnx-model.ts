@@ -189,6 +189,15 @@ class OrtWorker {
   get failed(): boolean {
     return this.failure !== null;
   }
+
+  /**
+   * Give up on `w`, whose onnxruntime could not load its runtime (onnxruntime remembers a failed set-up for the
+   * worker's life): the next session asked for starts a new worker, which fetches the runtime again.
+   */
+  static discard(w: OrtWorker, why: Error): void {
+    if (OrtWorker.shared === w) OrtWorker.shared = null;
+    w.fail(why);
+  }
 }
 
 /** A session in onnxruntime's worker. */
@@ -289,6 +298,13 @@ export class OnnxModel {
       await worker.started;
       return await WorkerRunner.create(worker, spec, provider);
     } catch (e) {
+      if (!worker.failed && /no available backend/i.test((e as Error).message)) {
+        // The runtime itself (ort-wasm-*.wasm) did not load: a failed or damaged download. A later load tries anew.
+        const error = new ModelLoadError(`onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}) could not be loaded; ` +
+          `reload or try again (${(e as Error).message.split('\n')[0]})`);
+        OrtWorker.discard(worker, error);
+        throw error;
+      }
       if (!worker.failed) throw e; // the model's own error (the page would give the same)
       console.warn(`onnxruntime's worker failed (${(e as Error).message}); ${spec.name} runs in the page`);
       return PageRunner.create(spec, provider);

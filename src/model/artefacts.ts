@@ -71,9 +71,10 @@ export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<Arr
     : await fetchManifest(options.manifestUrl, fetchFn);
   const file = async (key: string): Promise<ArrayBuffer> => {
     const url = new URL(manifest.files[key], manifestUrl);
-    const r = await fetchFn(url);
+    const lost = (e: Error) => new ModelLoadError(`could not fetch model file ${manifest.files[key]} (${url}): ${e.message}`);
+    const r = await fetchFn(url).catch((e: Error) => Promise.reject(lost(e)));
     if (!r.ok) throw new ModelLoadError(`model file ${manifest.files[key]} is missing (HTTP ${r.status} for ${url})`);
-    const bytes = await r.arrayBuffer();
+    const bytes = await r.arrayBuffer().catch((e: Error) => Promise.reject(lost(e))); // the connection dropped midway
     if ((await sha256Hex(bytes)) !== manifest.sha256[key]) throw new ModelLoadError(`model file ${manifest.files[key]} is corrupt or from another export (SHA-256 mismatch)`);
     return bytes;
   };

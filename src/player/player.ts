@@ -92,6 +92,7 @@ export class Player {
   private playing: Playing | null = null;
   private currentFrame = 0;
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
+  private forgetGesture: () => void = () => undefined; // removes the listeners awaitGesture left on the document
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
   constructor(private readonly view: PlayerView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
@@ -211,9 +212,11 @@ export class Player {
   /** The sound is held back until a gesture: resume the context on the next one (the face follows its clock). */
   private awaitGesture(context: AudioContext, playing: Playing): void {
     this.options.onBlocked?.();
-    const forget = () => {
+    this.forgetGesture();
+    const forget = (this.forgetGesture = () => {
       for (const g of GESTURES) document.removeEventListener(g, resume, true);
-    };
+      this.forgetGesture = () => undefined;
+    });
     const resume = () => {
       void context.resume().then(() => {
         forget();
@@ -232,6 +235,7 @@ export class Player {
 
   /** Stop playback (the face keeps the frame it shows). */
   stop(): void {
+    this.forgetGesture(); // a player stopped (or removed with its element) waits for no gesture: nor keeps its view alive
     this.liveQuiet = LIVE_REST_FRAMES; // a live session after this starts at rest, whatever the last one ended on
     const p = this.playing;
     if (!p) return;

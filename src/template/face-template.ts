@@ -188,7 +188,8 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
 
 /** Fetch a template by the URL of its header; the binary is resolved next to it. */
 export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch): Promise<FaceTemplate> {
-  const res = await fetchFn(headerUrl);
+  const lost = (url: string | URL) => (e: Error) => Promise.reject(new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}`));
+  const res = await fetchFn(headerUrl).catch(lost(headerUrl));
   if (!res.ok) throw new TemplateFormatError(`could not load the face template ${headerUrl}: HTTP ${res.status}`);
   let header: TemplateHeader;
   try {
@@ -197,9 +198,9 @@ export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetc
     throw new TemplateFormatError(`face template ${headerUrl} is not valid JSON: ${(e as Error).message}`);
   }
   const binUrl = new URL(header.binary, new URL(String(headerUrl), globalThis.location?.href ?? 'file:///'));
-  const bin = await fetchFn(binUrl);
+  const bin = await fetchFn(binUrl).catch(lost(binUrl));
   if (!bin.ok) throw new TemplateFormatError(`could not load the template binary ${binUrl}: HTTP ${bin.status}`);
-  return decodeTemplate(header, await bin.arrayBuffer());
+  return decodeTemplate(header, await bin.arrayBuffer().catch(lost(binUrl)));
 }
 
 /** Build a template from a bare mesh plus region index lists (a user's OBJ/PLY and masks file). */

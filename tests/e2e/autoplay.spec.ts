@@ -43,3 +43,41 @@ test('autoplay held back until a gesture: the element says so, then plays on a c
   // Frames are shown as the page draws (a few a second under a software GPU), and each one sends a frame event.
   expect(Number(/after (\d+) frames/.exec(log.find((l) => l.startsWith('auto: ended'))!)![1])).toBeGreaterThan(5);
 });
+
+test('an element removed while its clip waits for a gesture leaves no listener on the document', async ({ page, guard }) => {
+  test.setTimeout(120_000);
+  guard.allowConsoleError(/AudioContext was not allowed to start/);
+  await page.addInitScript(() => {
+    const g = globalThis as unknown as { listening: number };
+    g.listening = 0;
+    const add = document.addEventListener.bind(document), remove = document.removeEventListener.bind(document);
+    document.addEventListener = (type: string, ...rest: [EventListenerOrEventListenerObject, (boolean | AddEventListenerOptions)?]) => {
+      if (type === 'pointerdown') g.listening++;
+      return add(type, ...rest);
+    };
+    document.removeEventListener = (type: string, ...rest: [EventListenerOrEventListenerObject, (boolean | EventListenerOptions)?]) => {
+      if (type === 'pointerdown') g.listening--;
+      return remove(type, ...rest);
+    };
+    document.addEventListener('DOMContentLoaded', () => {
+      const el = document.createElement('talking-face');
+      el.id = 'held';
+      el.setAttribute('src', '/examples/sample.wav');
+      el.setAttribute('autoplay', '');
+      document.body.prepend(el);
+      // Watched from here, not by evaluate() (a gesture, which would let the sound start).
+      void customElements.whenDefined('talking-face').then(() => {
+        const status = el.shadowRoot!.querySelector('p.status')!;
+        new MutationObserver(() => console.log(`held status: ${status.textContent}`)).observe(status, { childList: true, characterData: true, subtree: true });
+      });
+    });
+  });
+  const log: string[] = [];
+  page.on('console', (m) => m.text().startsWith('held') && log.push(m.text()));
+  await page.goto('/examples/embed.html');
+  const listening = () => page.evaluate(() => (globalThis as unknown as { listening: number }).listening);
+  await expect.poll(() => log.some((l) => l.includes('Click or press a key')), { timeout: 60_000 }).toBe(true);
+  const waiting = await listening();
+  await page.evaluate(() => document.getElementById('held')!.remove());
+  expect(await listening(), 'pointerdown listeners once the waiting element left').toBe(waiting - 1);
+});

@@ -1,0 +1,36 @@
+import { test, expect } from './fixtures';
+
+/**
+ * <talking-face> when its files do not arrive (examples/embed.html): a model whose load failed (onnxruntime's runtime
+ * not downloaded; a model file's connection dropped) loads on the next speak() once the network is back, and shows
+ * its face; the errors name the file.
+ */
+type El = HTMLElement & { speak(a: unknown): Promise<void>; ready: Promise<unknown> };
+
+const events = (page: import('@playwright/test').Page) => page.evaluate(() => (globalThis as unknown as { seen: string[] }).seen);
+
+for (const [fault, pattern] of [['the runtime (.wasm) is not found', '**/ort/*/ort-wasm-simd-threaded.wasm'], ['a model file\'s connection drops', '**/models/gava.safetensors']] as const) {
+  test(`${fault}: an error naming it, then the next speak() loads the model and plays`, async ({ page, context, guard }) => {
+    test.setTimeout(120_000);
+    // What the browser logs of the failed download (onnxruntime's wasm loader; the failed fetch).
+    guard.allowConsoleError(/wasm|WebAssembly|magic word|Aborted\(|ArrayBuffer instantiation|Failed to load resource|ERR_CONNECTION_RESET|net::/);
+    await context.route(pattern, (r) => (pattern.endsWith('.wasm') ? r.fulfill({ status: 404, body: 'not here' }) : r.abort('connectionreset')));
+    await page.addInitScript(() => {
+      const g = globalThis as unknown as { seen: string[] };
+      g.seen = [];
+      for (const type of ['ready', 'error', 'ended']) {
+        document.addEventListener(type, (e) => (e.target as HTMLElement).id === 'left' && g.seen.push(`${type}${type === 'error' ? `:${(e as CustomEvent).detail.stage}:${(e as CustomEvent).detail.message}` : ''}`), true);
+      }
+    });
+    await page.goto('/examples/embed.html');
+    await expect.poll(() => events(page), { timeout: 60_000 }).toContainEqual(expect.stringMatching(/^error:model:/));
+    const [error] = (await events(page)).filter((e) => e.startsWith('error'));
+    expect(error).toMatch(pattern.endsWith('.wasm') ? /ort-wasm/ : /gava\.safetensors/);
+    await context.unrouteAll({ behavior: 'ignoreErrors' });
+    const spoke = await page.evaluate(() => (document.getElementById('left') as El).speak('/examples/sample.wav').then(() => 'played', (e: Error) => `failed: ${e.message}`));
+    expect(spoke).toBe('played');
+    const seen = await events(page);
+    expect(seen.filter((e) => e === 'ready'), 'ready once the retry loaded').toHaveLength(1);
+    expect(seen.at(-1)).toBe('ended');
+  });
+}
