@@ -31,7 +31,7 @@ export interface FrameDetail extends Partial<FrameWeights> {
 export interface TalkingFaceErrorDetail {
   message: string;
   /** What failed: loading the model, decoding audio, the microphone, inference, or the avatar. */
-  stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar';
+  stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar' | 'render';
 }
 
 /** A frame of a take being played: its compute time and real-time factor (none for a clip too short to say). */

@@ -18,7 +18,8 @@ export class ElementStage {
   private token = {};
   private made: Promise<unknown> = Promise.resolve();
 
-  constructor(private canvas: HTMLCanvasElement, private readonly events: PlayerOptions) {}
+  /** `onContext(true)`: the browser took the view's WebGL context (it keeps 16 a page); `onContext(false)`: it gave it back. */
+  constructor(private canvas: HTMLCanvasElement, private readonly events: PlayerOptions, private readonly onContext: (lost: boolean) => void = () => undefined) {}
 
   /**
    * Make the view on a fresh canvas (a second WebGL renderer cannot share one: parts.ts) with its player: the avatar
@@ -32,6 +33,8 @@ export class ElementStage {
     this.canvas.replaceWith(canvas);
     this.canvas = canvas;
     canvas.addEventListener('keydown', (ev) => cameraKey(ev, canvas === this.canvas ? this.view : null));
+    canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.onContext(true));
+    canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.onContext(false));
     const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, headBone)
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;

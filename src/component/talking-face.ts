@@ -55,7 +55,8 @@ export class TalkingFaceElement extends HTMLElement {
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
       onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
       onUnblocked: () => this.setStatus(this.playingStatus),
-    });
+    }, (lost) => (lost ? this.fail('render', 'the face can no longer be drawn: the browser took its WebGL context (too many 3D views on '
+      + 'the page?); it is drawn again if the browser gives it back') : this.setStatus('The face is drawn again.')));
   }
 
   /** Resolves with the engine once the model is loaded (rejects if it cannot be). */

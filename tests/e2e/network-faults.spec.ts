@@ -3,7 +3,7 @@ import { test, expect } from './fixtures';
 /**
  * <talking-face> when its files do not arrive (examples/embed.html): a model whose load failed (onnxruntime's runtime
  * not downloaded; a model file's connection dropped) loads on the next speak() once the network is back, and shows
- * its face; the errors name the file.
+ * its face; the errors name the file; a face whose WebGL context the browser takes (16 a page) says so.
  */
 type El = HTMLElement & { speak(a: unknown): Promise<void>; ready: Promise<unknown> };
 
@@ -34,3 +34,21 @@ for (const [fault, pattern] of [['the runtime (.wasm) is not found', '**/ort/*/o
     expect(seen.at(-1)).toBe('ended');
   });
 }
+
+test('a face whose WebGL context the browser takes says so, and again when it is given back', async ({ page, guard }) => {
+  test.setTimeout(60_000);
+  guard.allowConsoleError(/WebGL|CONTEXT_LOST/);
+  await page.goto('/examples/embed.html');
+  await page.evaluate(() => (document.getElementById('left') as El).ready);
+  const status = () => page.evaluate(() => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent);
+  await expect.poll(status, { timeout: 30_000 }).toContain('Ready');
+  const errors = page.evaluate(() => new Promise<string>((resolve) => document.getElementById('left')!.addEventListener('error', (e) => resolve((e as unknown as CustomEvent).detail.stage), { once: true })));
+  await page.evaluate(() => {
+    const gl = document.getElementById('left')!.shadowRoot!.querySelector('canvas')!.getContext('webgl2')!;
+    const ext = gl.getExtension('WEBGL_lose_context')!;
+    ext.loseContext();
+    setTimeout(() => ext.restoreContext(), 500);
+  });
+  expect(await errors).toBe('render');
+  await expect.poll(status, { timeout: 10_000 }).toBe('The face is drawn again.');
+});
