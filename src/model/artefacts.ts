@@ -19,6 +19,52 @@ export interface ArtefactOptions {
   /** The face template, when the caller has loaded it or is loading it (it must be the manifest's). */
   template?: FaceTemplate | Promise<FaceTemplate>;
   fetch?: typeof fetch;
+  /**
+   * A runtime file whose download brings nothing for this many seconds fails, naming it (default 30), rather than
+   * wait forever on a stalled connection; a slow one that keeps coming is waited for.
+   */
+  stallSeconds?: number;
+}
+
+/** The default of ArtefactOptions.stallSeconds. */
+export const STALL_SECONDS = 30;
+
+/** The body of `url`, or a rejection once nothing has arrived for `stallMs` (headers or bytes). */
+async function fetchUnlessStalled(url: URL, fetchFn: typeof fetch, stallMs: number, what: string): Promise<ArrayBuffer> {
+  const abort = new AbortController();
+  let timer = setTimeout(() => abort.abort(), stallMs);
+  const alive = () => {
+    clearTimeout(timer);
+    timer = setTimeout(() => abort.abort(), stallMs);
+  };
+  const failed = (e: Error) => new ModelLoadError(abort.signal.aborted
+    ? `${what} stalled: nothing arrived for ${stallMs / 1000} s (${url}); check the connection and try again`
+    : `could not fetch ${what} (${url}): ${e.message}`);
+  try {
+    const r = await fetchFn(url, { signal: abort.signal });
+    if (!r.ok) throw new ModelLoadError(`${what} is missing (HTTP ${r.status} for ${url})`);
+    if (!r.body) return await r.arrayBuffer();
+    const reader = r.body.getReader();
+    const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new Error('stalled')), { once: true }));
+    stalled.catch(() => undefined); // deliberate: read in the race below, or never needed once the body is in
+    const chunks: Uint8Array[] = [];
+    let length = 0;
+    for (;;) {
+      const { done, value } = await Promise.race([reader.read(), stalled]);
+      if (done) break;
+      alive();
+      chunks.push(value);
+      length += value.length;
+    }
+    const bytes = new Uint8Array(length);
+    let o = 0;
+    for (const c of chunks) bytes.set(c, (o += c.length) - c.length);
+    return bytes.buffer;
+  } catch (e) {
+    throw e instanceof ModelLoadError ? e : failed(e as Error);
+  } finally {
+    clearTimeout(timer);
+  }
 }
 
 /** Where the face template is when the manifest cannot be read (the exporter's layout), so a page can still show a face. */
@@ -71,10 +117,7 @@ export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<Arr
     : await fetchManifest(options.manifestUrl, fetchFn);
   const file = async (key: string): Promise<ArrayBuffer> => {
     const url = new URL(manifest.files[key], manifestUrl);
-    const lost = (e: Error) => new ModelLoadError(`could not fetch model file ${manifest.files[key]} (${url}): ${e.message}`);
-    const r = await fetchFn(url).catch((e: Error) => Promise.reject(lost(e)));
-    if (!r.ok) throw new ModelLoadError(`model file ${manifest.files[key]} is missing (HTTP ${r.status} for ${url})`);
-    const bytes = await r.arrayBuffer().catch((e: Error) => Promise.reject(lost(e))); // the connection dropped midway
+    const bytes = await fetchUnlessStalled(url, fetchFn, (options.stallSeconds ?? STALL_SECONDS) * 1000, `model file ${manifest.files[key]}`);
     if ((await sha256Hex(bytes)) !== manifest.sha256[key]) throw new ModelLoadError(`model file ${manifest.files[key]} is corrupt or from another export (SHA-256 mismatch)`);
     return bytes;
   };

@@ -52,3 +52,30 @@ describe('fetchArtefacts', () => {
     await Promise.allSettled([...Object.values(a.files), ...Object.values(b.files)]);
   });
 });
+
+describe('a stalled download', () => {
+  it('fails naming the file once nothing has arrived for stallSeconds; a slow one that keeps coming is waited for', async () => {
+    const stalling = (file: string, trickle: boolean): typeof fetch => (async (input: RequestInfo | URL, init?: RequestInit) => {
+      const url = String(input);
+      if (!url.endsWith(file)) return diskFetch()(input, init);
+      const bytes = new Uint8Array(await (await diskFetch()(input)).arrayBuffer());
+      let sent = 0;
+      return new Response(new ReadableStream({
+        async pull(c) {
+          if (!trickle && sent > 0) return new Promise<void>(() => undefined); // a first chunk, then nothing
+          await new Promise((r) => setTimeout(r, trickle ? 20 : 0));
+          const n = Math.min(bytes.length - sent, trickle ? Math.ceil(bytes.length / 8) : 1000);
+          c.enqueue(bytes.slice(sent, (sent += n)));
+          if (sent >= bytes.length) c.close();
+        },
+      }));
+    }) as typeof fetch;
+    const file = JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8')).files.hierarchical as string;
+    const stalled = await fetchArtefacts({ manifestUrl, fetch: stalling(file, false), stallSeconds: 0.15 });
+    await expect(stalled.files.hierarchical).rejects.toThrow(new RegExp(`model file ${file} stalled: nothing arrived for 0.15 s`));
+    await Promise.allSettled([stalled.template, ...Object.values(stalled.files)]);
+    const slow = await fetchArtefacts({ manifestUrl, fetch: stalling(file, true), stallSeconds: 0.15 });
+    expect((await slow.files.hierarchical).byteLength).toBeGreaterThan(1000); // 8 pieces 20 ms apart: 160 ms in all
+    await Promise.allSettled([slow.template, ...Object.values(slow.files)]);
+  });
+});
