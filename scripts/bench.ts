@@ -19,7 +19,7 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
-import { portFree, positiveNumbers, readOptions, startServer, usageError } from './script-cli';
+import { envPort, portFree, positiveNumbers, readOptions, startServer, usageError } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const USAGE = `npm run bench [-- OPTIONS]   the engine's speed and memory in headless Chromium -> docs/results/bench.json
@@ -41,8 +41,7 @@ if (o['render-only'] && !existsSync(OUT)) usageError('bench', USAGE, `--render-o
 const seconds = positiveNumbers(String(o.seconds)) ?? usageError('bench', USAGE, `--seconds takes clip lengths above 0, such as 10,60 (not ${o.seconds})`);
 const backends = String(o.backends).split(',');
 if (!backends.every((b) => b === 'cpu' || b === 'webgpu')) usageError('bench', USAGE, `--backends takes cpu and/or webgpu (not ${o.backends})`);
-const PORT = Number(process.env.BENCH_PORT ?? 4191);
-if (!(Number.isInteger(PORT) && PORT > 0 && PORT < 65536)) usageError('bench', USAGE, `BENCH_PORT must be a port number (not ${process.env.BENCH_PORT})`);
+const PORT = envPort('bench', USAGE, 'BENCH_PORT', 4191);
 const renderOnly = Boolean(o['render-only']);
 const firstLoadOnly = Boolean(o['first-load-only']);
 if (o['first-load-url'] && !firstLoadOnly) usageError('bench', USAGE, '--first-load-url goes with --first-load-only (another page\'s figures are not written into bench.json)');

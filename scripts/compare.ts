@@ -23,7 +23,7 @@ import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
 import { readWav16 } from '../tests/e2e/helpers/audio';
-import { portFree, readOptions, startServer, usageError } from './script-cli';
+import { envPort, portFree, readOptions, startServer, usageError } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -44,8 +44,7 @@ if (!(Number.isInteger(MAX_CLIPS) && MAX_CLIPS > 0) && MAX_CLIPS !== Infinity) u
 const SAMPLES = o.samples ? resolve(ROOT, String(o.samples)) : null;
 const OUT = resolve(ROOT, String(o.out ?? 'docs/results/peers'));
 if (!existsSync(dirname(OUT))) usageError('compare', USAGE, `--out ${o.out}: the folder ${dirname(OUT)} does not exist`);
-const PORT = Number(process.env.COMPARE_PORT ?? 4193);
-if (!(Number.isInteger(PORT) && PORT > 0 && PORT < 65536)) usageError('compare', USAGE, `COMPARE_PORT must be a port number (not ${process.env.COMPARE_PORT})`);
+const PORT = envPort('compare', USAGE, 'COMPARE_PORT', 4193);
 const BILABIALS = new Set(['P', 'B', 'M']);
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']); // corpus/checks.py OPEN_VOWELS
 const HA_NAMES = ['aa', 'E', 'I', 'O', 'U', 'PP', 'SS', 'TH', 'DD', 'FF', 'kk', 'nn', 'RR', 'CH', 'sil'];

@@ -37,6 +37,12 @@ export function positiveNumbers(text: string): number[] | null {
   return xs.length > 0 && xs.every((x) => Number.isFinite(x) && x > 0) ? xs : null;
 }
 
+/** The port in environment variable `name` (default `fallback`), or exit 2 saying it is not one. */
+export function envPort(script: string, usage: string, name: string, fallback: number): number {
+  const port = Number(process.env[name] ?? fallback);
+  return Number.isInteger(port) && port > 0 && port < 65536 ? port : usageError(script, usage, `${name} must be a port number (not ${process.env[name]})`);
+}
+
 /** Whether nothing listens on `port` of 127.0.0.1 (a server there would be measured instead of ours). */
 export function portFree(port: number): Promise<boolean> {
   return new Promise((resolve) => {

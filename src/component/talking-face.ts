@@ -222,8 +222,10 @@ export class TalkingFaceElement extends HTMLElement {
     cancelled?.abort(); // an animation under way stops at its next chunk
     const wasPlaying = this.stage.player?.isPlaying ?? false;
     this.stage.player?.stop();
-    if (wasPlaying || this.live) (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
-    if (wasPlaying || this.live) this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
+    if (wasPlaying || this.live) {
+      (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
+      this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
+    }
     if (this.live) {
       const [live, gen] = [this.live, this.generation];
       this.live = null;
