@@ -74,6 +74,9 @@ class Batch:
     vertices: torch.Tensor    # (B, T, N, 3) unposed ground truth
     pose: torch.Tensor        # (B, T, 6)
 
+    def to(self, device: str | torch.device) -> "Batch":
+        return Batch(*(getattr(self, f).to(device) for f in self.__dataclass_fields__))
+
 
 def attach_rest_faces(clips: list[PreparedClip], template: Template, audio: AudioConfig = AudioConfig()) -> dict[str, float]:
     """Give every clip its subject's rest face (subjects told apart by their neutral template).

@@ -1,4 +1,4 @@
-"""Train the model on any dataset `open_dataset` reads.
+"""Train the model on any dataset `open_dataset` reads (or its clips packed by train/packed.py, on a GPU).
 
   scripts/py -m talkingface.train.train --corpus data/corpus --out runs/default --minutes 55
   scripts/py -m talkingface.train.train --corpus data/corpus --out runs/lg-mlp --decoder MLP --steps 800
@@ -23,7 +23,7 @@ import torch
 import torch.distributed as dist
 
 from ..data.datasets import open_dataset
-from ..features import AudioConfig, warp_mel
+from ..features import AudioConfig
 from ..geometry.pose_torch import apply_pose
 from ..model import lip_closure as lc
 from ..model.config import ModelConfig
@@ -31,7 +31,9 @@ from ..model.gava import TalkingFace, count_parameters
 from ..paths import REPO_ROOT, TEMPLATE_DIR
 from ..cli import check_run_folder, read_checkpoint, require_positive
 from ..template import Template, TemplateFormatError, load_template
+from . import packed
 from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
+from .frontend_input import content_warp, load_frontend
 from .losses import LossWeights, total_loss
 from .metrics import eye_region, inner_lip_pairs, lip_region
 
@@ -72,7 +74,10 @@ def model_of(ck: dict, template: Template | None = None, name: str | Path = "the
 def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="python -m talkingface.train.train", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--corpus", required=True, help="dataset folder (our corpus, processed VOCASET or Multiface)")
+    src = ap.add_mutually_exclusive_group(required=True)
+    src.add_argument("--corpus", help="dataset folder (our corpus, processed VOCASET or Multiface)")
+    src.add_argument("--packed", help="its training clips packed into one file instead (train/packed.py: for a machine without the dataset)")
+    ap.add_argument("--device", default="cpu", help="torch device to train on (cpu, cuda); the checkpoint saved is the same")
     ap.add_argument("--template", help="template for a real dataset (template.json, or a mesh with --masks)")
     ap.add_argument("--masks", help="region masks for a mesh template")
     ap.add_argument("--out", required=True, help="run folder for checkpoints and logs")
@@ -128,36 +133,13 @@ def parse_args(argv=None) -> argparse.Namespace:
         ap.error("--content-warp needs a frozen --frontend (it degrades what a trained front-end hears)")
     if args.content_warp and not 0.5 < args.content_warp[0] <= args.content_warp[1] < 2:
         ap.error("--content-warp LO HI: factors with 0.5 < LO <= HI < 2, e.g. 1.12 1.22")
+    if args.packed and (args.template or args.masks):
+        ap.error("--template and --masks are packed with the clips: give them to train.packed")
+    if args.lip_closure and args.device != "cpu":
+        ap.error("--lip-closure retargets each face on the CPU: train with --device cpu")
+    if args.device.startswith("cuda") and not torch.cuda.is_available():
+        ap.error(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
     return args
-
-
-def content_warp(mel: torch.Tensor, rng: np.random.Generator, lo: float, hi: float) -> torch.Tensor:
-    """Each crop's Mel axis stretched by a factor in [lo, hi] or shrunk by its inverse (vocal-tract length).
-
-    A frozen front-end hears the mesh corpus's training voices far better than voices it has never heard
-    (measured on the shipped one: frame accuracy 82% on train clips, 64% on the test split's held-out voices).
-    A decoder trained on its confident train posteriors learns to close the lips only on a confident P; on a
-    new voice it might then miss bilabials the front-end did hear. A warp of 1.2 brings the train clips to the
-    held-out voices' accuracy (66%), so the decoder learns to read the posteriors it will get from a stranger.
-    Tried on the shipped model, it did not help: the decoder already closes what it hears on the val split
-    (docs/results/README.md, "Tried next")."""
-    out = mel.clone()
-    for b in range(mel.shape[0]):
-        f = rng.uniform(lo, hi)
-        out[b] = torch.from_numpy(warp_mel(mel[b].numpy(), f if rng.random() < 0.5 else 1 / f))
-    return out
-
-
-def load_frontend(path: str) -> dict:
-    """A front-end file (frontend.train's frontend.pt), or the content encoder of a face checkpoint in the same form
-    (so a model can be fine-tuned on the shipped front-end after runs/, which holds the front-end's own run, is gone)."""
-    ck = read_checkpoint(path, kind="any")
-    if "content" in ck:
-        return ck
-    if "model" not in ck:
-        raise SystemExit(f"--frontend: {path} is neither a front-end (frontend.pt) nor a face checkpoint")
-    content = {k[len("content."):]: v for k, v in ck["model"].items() if k.startswith("content.")}
-    return {"model_config": ck["model_config"], "content": content, "step": ck["step"]}
 
 
 def main(argv=None) -> int:
@@ -173,26 +155,32 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
 
-    ds = open_dataset(args.corpus, args.template, args.masks)
-    audio = AudioConfig(fps=int(ds.fps))
+    t0 = time.time()
+    if args.packed:
+        clips, template, template_path, fps = packed.load(args.packed)
+    else:
+        ds = open_dataset(args.corpus, args.template, args.masks)
+        template, fps = ds.template, ds.fps
+        template_path = args.template or str(Path(args.corpus) / "template" / "template.json")
+    audio = AudioConfig(fps=int(fps))
+    if not args.packed:
+        clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     frontend = load_frontend(args.frontend) if args.frontend else None
     content_keys = ("content_arch", "content_channels", "content_classes", "content_stride", "content_ahead")
     content_cfg = {k: getattr(ModelConfig.from_dict(frontend["model_config"]), k) for k in content_keys} if frontend else {}
     window = {"window_future": args.window_future} if args.window_future is not None else {}
     cfg = ModelConfig(features=args.features, decoder=args.decoder, variant=args.variant,
                       template_input="L" in args.features and args.template_input, **content_cfg, **window)
-    t0 = time.time()
-    clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     log(f"{cfg.name} ({cfg.variant}): {len(clips)} training clips, {sum(c.num_frames for c in clips)} frames, "
         f"prepared in {time.time() - t0:.0f} s; {world} process(es)")
 
     if args.silence > 0:
-        gaps = attach_rest_faces(clips, ds.template, audio)
+        gaps = attach_rest_faces(clips, template, audio)
         log(f"silence crops: {args.silence:.0%} of crops; rest faces' inner-lip gap {min(gaps.values()):.2f}-{max(gaps.values()):.2f} mm "
             f"({len(gaps)} subjects)")
 
     torch.manual_seed(args.seed)
-    model = TalkingFace(cfg, ds.template, audio)
+    model = TalkingFace(cfg, template, audio)
     mean, std = mel_statistics(clips)
     for norm in (model.pose_encoder.norm,) if frontend else (model.content.norm, model.pose_encoder.norm):
         norm.mean.copy_(torch.from_numpy(mean))
@@ -218,6 +206,7 @@ def main(argv=None) -> int:
         model.content.load_state_dict(frontend["content"])
         model.content.requires_grad_(args.tune_frontend)
         log(f"front-end {args.frontend} ({frontend['step']} steps){'' if args.tune_frontend else ', frozen'}")
+    model.to(args.device)
     shape = [p for n, p in model.named_parameters() if n.startswith("hierarchical.shape_in.")]
     rest = [p for n, p in model.named_parameters() if p.requires_grad and not n.startswith("hierarchical.shape_in.")]
     opt = torch.optim.Adam([{"params": rest, "scale": 1.0}] + ([{"params": shape, "scale": args.shape_lr_scale}] if shape else []), lr=args.lr)
@@ -234,9 +223,7 @@ def main(argv=None) -> int:
     net = torch.nn.parallel.DistributedDataParallel(model) if distributed else model
     log(f"{count_parameters(model):,} parameters ({count_parameters(model) * 4 / 1e6:.2f} MB float32)")
 
-    eye = torch.from_numpy(eye_region(ds.template))
-    lips = torch.from_numpy(lip_region(ds.template))
-    pairs = torch.from_numpy(inner_lip_pairs(ds.template))
+    eye, lips, pairs = (torch.from_numpy(f(template)).to(args.device) for f in (eye_region, lip_region, inner_lip_pairs))
     rng = np.random.default_rng(args.seed * 1000 + rank + step)
     budget_steps = args.steps
     total_est = budget_steps or 0
@@ -245,15 +232,14 @@ def main(argv=None) -> int:
     def save(path: Path) -> None:
         if rank != 0:
             return
-        torch.save({"model": model.state_dict(), "optimizer": opt.state_dict(), "step": step,
+        torch.save({"model": {k: v.cpu() for k, v in model.state_dict().items()}, "optimizer": opt.state_dict(), "step": step,
                     "trained_seconds": trained_seconds, "model_config": cfg.to_dict(), "audio_config": audio.to_dict(),
-                    "template_id": ds.template.id, "template_path": str(Path(args.corpus) / "template" / "template.json")
-                    if args.template is None else args.template, "args": vars(args), "world_size": world}
+                    "template_id": template.id, "template_path": template_path, "args": vars(args), "world_size": world}
                    | ({"lip_closure": {"reference_gap_mm": args.lip_closure, "split": "train (in the loss)"}} if args.lip_closure else {}),
                    path.with_suffix(".tmp"))
         os.replace(path.with_suffix(".tmp"), path)
 
-    closers = lc.Closers(ds.template, args.lip_closure) if args.lip_closure else None
+    closers = lc.Closers(template, args.lip_closure) if args.lip_closure else None
 
     def retarget(out_: dict, faces: torch.Tensor) -> dict:
         """The model's offsets with the closure on each clip's own face (--lip-closure), posed again."""
@@ -279,7 +265,8 @@ def main(argv=None) -> int:
             for g in opt.param_groups:
                 g["lr"] = g.get("scale", 1.0) * args.lr * (0.05 + 0.95 * 0.5 * (1 + np.cos(np.pi * min(progress, 1.0))))
             b = sample_batch(clips, rng, args.batch_clips, args.frames, cfg, audio, args.silence)
-            heard = content_warp(b.mel, rng, *args.content_warp) if args.content_warp else None
+            heard = content_warp(b.mel, rng, *args.content_warp).to(args.device) if args.content_warp else None
+            b = b.to(args.device)
             out_ = net(b.mel, b.mel_index, b.template, content_mel=heard)
             if args.lip_closure:
                 out_ = retarget(out_, b.template)
