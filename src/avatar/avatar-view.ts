@@ -14,6 +14,7 @@ import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import { GltfAvatar } from './gltf-avatar';
 import { Blinks } from './blinks';
 import { softwareWebGL } from '../render/software-gl';
+import { fetchBody, StalledError } from '../model/fetch-body';
 
 /** About a head's bounding radius in metres (glTF's unit). */
 const HEAD_RADIUS = 0.15;
@@ -81,12 +82,13 @@ export class AvatarView {
 
   /** Fetch, parse and show the avatar at `url` (AvatarLoadError says what is wrong with it). */
   static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null): Promise<AvatarView> {
-    const res = await fetch(url).catch((e: Error) => {
+    const res = await fetchBody(url).catch((e: Error) => {
       const other = new URL(url, location.href).origin !== location.origin;
-      throw new Error(`could not fetch the avatar ${url}: ${e.message}${other ? ' (another origin: does it send CORS headers?)' : ''}`);
+      const hint = e instanceof StalledError ? '; check the connection and try again' : other ? ' (another origin: does it send CORS headers?)' : '';
+      throw new Error(`could not fetch the avatar ${url}: ${e.message}${hint}`);
     });
     if (!res.ok) throw new Error(`could not fetch the avatar ${url}: HTTP ${res.status}`);
-    return new AvatarView(canvas, await GltfAvatar.parse(await res.arrayBuffer(), url, headBone));
+    return new AvatarView(canvas, await GltfAvatar.parse(res.bytes, url, headBone));
   }
 
   /** The speech weight now (0: the rest, 1: the frame given), as FaceView's. */

@@ -4,6 +4,7 @@
  */
 import { checkManifest, DEFAULT_MANIFEST_URL, type Manifest } from './manifest';
 import { loadTemplate, type FaceTemplate } from '../template/face-template';
+import { fetchBody, StalledError, type FetchBodyOptions } from './fetch-body';
 
 export class ModelLoadError extends Error {
   override name = 'ModelLoadError';
@@ -20,51 +21,23 @@ export interface ArtefactOptions {
   template?: FaceTemplate | Promise<FaceTemplate>;
   fetch?: typeof fetch;
   /**
-   * A runtime file whose download brings nothing for this many seconds fails, naming it (default 30), rather than
-   * wait forever on a stalled connection; a slow one that keeps coming is waited for.
+   * A download (the manifest, the template, a runtime file) that brings nothing for this many seconds fails, naming
+   * it (default 30), rather than wait forever on a stalled connection; a slow one that keeps coming is waited for.
    */
   stallSeconds?: number;
 }
 
-/** The default of ArtefactOptions.stallSeconds. */
-export const STALL_SECONDS = 30;
+export { STALL_SECONDS } from './fetch-body';
 
-/** The body of `url`, or a rejection once nothing has arrived for `stallMs` (headers or bytes). */
-async function fetchUnlessStalled(url: URL, fetchFn: typeof fetch, stallMs: number, what: string): Promise<ArrayBuffer> {
-  const abort = new AbortController();
-  let timer = setTimeout(() => abort.abort(), stallMs);
-  const alive = () => {
-    clearTimeout(timer);
-    timer = setTimeout(() => abort.abort(), stallMs);
-  };
-  const failed = (e: Error) => new ModelLoadError(abort.signal.aborted
-    ? `${what} stalled: nothing arrived for ${stallMs / 1000} s (${url}); check the connection and try again`
-    : `could not fetch ${what} (${url}): ${e.message}`);
-  try {
-    const r = await fetchFn(url, { signal: abort.signal });
-    if (!r.ok) throw new ModelLoadError(`${what} is missing (HTTP ${r.status} for ${url})`);
-    if (!r.body) return await r.arrayBuffer();
-    const reader = r.body.getReader();
-    const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new Error('stalled')), { once: true }));
-    stalled.catch(() => undefined); // deliberate: read in the race below, or never needed once the body is in
-    const chunks: Uint8Array[] = [];
-    let length = 0;
-    for (;;) {
-      const { done, value } = await Promise.race([reader.read(), stalled]);
-      if (done) break;
-      alive();
-      chunks.push(value);
-      length += value.length;
-    }
-    const bytes = new Uint8Array(length);
-    let o = 0;
-    for (const c of chunks) bytes.set(c, (o += c.length) - c.length);
-    return bytes.buffer;
-  } catch (e) {
-    throw e instanceof ModelLoadError ? e : failed(e as Error);
-  } finally {
-    clearTimeout(timer);
-  }
+/** `url`'s bytes, or a ModelLoadError naming `what` (missing, unreachable, or stalled for `stallSeconds`). */
+async function fetchNamed(url: URL, what: string, options: FetchBodyOptions): Promise<ArrayBuffer> {
+  const body = await fetchBody(url, options).catch((e: Error) => {
+    throw new ModelLoadError(e instanceof StalledError
+      ? `${what} stalled: ${e.message} (${url}); check the connection and try again`
+      : `could not fetch ${what} (${url}): ${e.message}`);
+  });
+  if (!body.ok) throw new ModelLoadError(`${what} is missing (HTTP ${body.status} for ${url})`);
+  return body.bytes;
 }
 
 /** Where the face template is when the manifest cannot be read (the exporter's layout), so a page can still show a face. */
@@ -74,15 +47,15 @@ export function resolveManifestUrl(url: string | URL | undefined): URL {
   return new URL(String(url ?? DEFAULT_MANIFEST_URL), globalThis.location?.href ?? 'file:///');
 }
 
-/** The manifest at `url`, checked. */
-export async function fetchManifest(url: string | URL | undefined, fetchFn: typeof fetch = fetch.bind(globalThis)): Promise<{ manifest: Manifest; manifestUrl: URL }> {
+/** The manifest at `url`, checked (ModelLoadError: missing, unreachable, stalled for `stallSeconds`, or unreadable). */
+export async function fetchManifest(url: string | URL | undefined, fetchFn: typeof fetch = fetch.bind(globalThis), stallSeconds?: number): Promise<{ manifest: Manifest; manifestUrl: URL }> {
   const manifestUrl = resolveManifestUrl(url);
-  const res = await fetchFn(manifestUrl).catch((e: Error) => {
-    throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}`);
+  const body = await fetchBody(manifestUrl, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
+    throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}${e instanceof StalledError ? '; check the connection and try again' : ''}`);
   });
-  if (!res.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${res.status}`);
+  if (!body.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${body.status}`);
   try {
-    return { manifest: checkManifest(await res.json()), manifestUrl };
+    return { manifest: checkManifest(JSON.parse(new TextDecoder().decode(body.bytes))), manifestUrl };
   } catch (e) {
     throw new ModelLoadError(`the model manifest ${manifestUrl} is unreadable: ${(e as Error).message}`);
   }
@@ -114,16 +87,16 @@ export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<Arr
   const fetchFn = options.fetch ?? fetch.bind(globalThis);
   const { manifest, manifestUrl } = options.manifest
     ? { manifest: checkManifest(options.manifest), manifestUrl: resolveManifestUrl(options.manifestUrl) }
-    : await fetchManifest(options.manifestUrl, fetchFn);
+    : await fetchManifest(options.manifestUrl, fetchFn, options.stallSeconds);
   const file = async (key: string): Promise<ArrayBuffer> => {
     const url = new URL(manifest.files[key], manifestUrl);
-    const bytes = await fetchUnlessStalled(url, fetchFn, (options.stallSeconds ?? STALL_SECONDS) * 1000, `model file ${manifest.files[key]}`);
+    const bytes = await fetchNamed(url, `model file ${manifest.files[key]}`, { fetch: fetchFn, stallSeconds: options.stallSeconds });
     if ((await sha256Hex(bytes)) !== manifest.sha256[key]) throw new ModelLoadError(`model file ${manifest.files[key]} is corrupt or from another export (SHA-256 mismatch)`);
     return bytes;
   };
   const template = (options.template
     ? Promise.resolve(options.template)
-    : loadTemplate(templateUrlOf(manifest, manifestUrl, options.templateUrl), fetchFn).catch((e: Error) => {
+    : loadTemplate(templateUrlOf(manifest, manifestUrl, options.templateUrl), fetchFn, options.stallSeconds).catch((e: Error) => {
       throw new ModelLoadError(`the face template could not be loaded: ${e.message}`);
     })).then((t) => {
     if (t.id !== manifest.template.id) {

@@ -11,6 +11,7 @@
  * with `scripts/import-template.ts` loads through the same code.
  */
 import { buildAdjacency, type Adjacency } from './mesh-topology';
+import { fetchBody, StalledError } from '../model/fetch-body';
 
 export const TEMPLATE_FORMAT = 'talking-face-template';
 
@@ -186,21 +187,27 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
   };
 }
 
-/** Fetch a template by the URL of its header; the binary is resolved next to it. */
-export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch): Promise<FaceTemplate> {
-  const lost = (url: string | URL) => (e: Error) => Promise.reject(new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}`));
-  const res = await fetchFn(headerUrl).catch(lost(headerUrl));
-  if (!res.ok) throw new TemplateFormatError(`could not load the face template ${headerUrl}: HTTP ${res.status}`);
+/**
+ * Fetch a template by the URL of its header; the binary is resolved next to it. A download that brings nothing for
+ * `stallSeconds` (default STALL_SECONDS) fails, naming it.
+ */
+export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch, stallSeconds?: number): Promise<FaceTemplate> {
+  const get = async (url: string | URL, what: string) => {
+    const body = await fetchBody(url, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
+      throw new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}${e instanceof StalledError ? '; check the connection and try again' : ''}`);
+    });
+    if (!body.ok) throw new TemplateFormatError(`could not load ${what} ${url}: HTTP ${body.status}`);
+    return body.bytes;
+  };
   let header: TemplateHeader;
+  const text = new TextDecoder().decode(await get(headerUrl, 'the face template'));
   try {
-    header = await res.json();
+    header = JSON.parse(text);
   } catch (e) {
     throw new TemplateFormatError(`face template ${headerUrl} is not valid JSON: ${(e as Error).message}`);
   }
   const binUrl = new URL(header.binary, new URL(String(headerUrl), globalThis.location?.href ?? 'file:///'));
-  const bin = await fetchFn(binUrl).catch(lost(binUrl));
-  if (!bin.ok) throw new TemplateFormatError(`could not load the template binary ${binUrl}: HTTP ${bin.status}`);
-  return decodeTemplate(header, await bin.arrayBuffer().catch(lost(binUrl)));
+  return decodeTemplate(header, await get(binUrl, 'the template binary'));
 }
 
 /** Build a template from a bare mesh plus region index lists (a user's OBJ/PLY and masks file). */

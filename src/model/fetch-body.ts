@@ -1,0 +1,65 @@
+/**
+ * A download that cannot hang: the body of a URL, or a rejection once nothing has arrived for a while (neither the
+ * response's headers nor the next bytes of its body). A slow download that keeps coming is waited for. Every file
+ * the page or the element fetches goes through it (the manifest, the template, the model files, an avatar, speak()'s
+ * audio URL), so a stalled connection ends in a message instead of "Loading…" forever.
+ */
+
+/** Seconds a download may bring nothing before it fails (the default of every `stallSeconds`). */
+export const STALL_SECONDS = 30;
+
+/** Nothing arrived for `stallSeconds`; the message says so, for the caller to name what was being fetched. */
+export class StalledError extends Error {
+  override name = 'StalledError';
+}
+
+export interface FetchedBody {
+  ok: boolean;
+  status: number;
+  /** The body (empty where the response is not ok: it is not read). */
+  bytes: ArrayBuffer;
+}
+
+export interface FetchBodyOptions {
+  fetch?: typeof fetch;
+  stallSeconds?: number;
+}
+
+/** The response to `url` and its whole body; StalledError once nothing has arrived for `stallSeconds`; fetch's own errors as they are. */
+export async function fetchBody(url: string | URL, options: FetchBodyOptions = {}): Promise<FetchedBody> {
+  const fetchFn = options.fetch ?? fetch.bind(globalThis);
+  const seconds = options.stallSeconds ?? STALL_SECONDS;
+  const abort = new AbortController();
+  let timer = setTimeout(() => abort.abort(), seconds * 1000);
+  const alive = () => {
+    clearTimeout(timer);
+    timer = setTimeout(() => abort.abort(), seconds * 1000);
+  };
+  const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(`nothing arrived for ${seconds} s`)), { once: true }));
+  stalled.catch(() => undefined); // deliberate: read in the races below, or never needed once the body is in
+  try {
+    // A fetch that ignores the signal (a page's own fetch function) still cannot hang: the race ends it.
+    const r = await Promise.race([fetchFn(url, { signal: abort.signal }), stalled]);
+    if (!r.ok) return { ok: false, status: r.status, bytes: new ArrayBuffer(0) };
+    alive();
+    if (!r.body) return { ok: true, status: r.status, bytes: await Promise.race([r.arrayBuffer(), stalled]) };
+    const reader = r.body.getReader();
+    const chunks: Uint8Array[] = [];
+    let length = 0;
+    for (;;) {
+      const { done, value } = await Promise.race([reader.read(), stalled]);
+      if (done) break;
+      alive();
+      chunks.push(value);
+      length += value.length;
+    }
+    const bytes = new Uint8Array(length);
+    let o = 0;
+    for (const c of chunks) bytes.set(c, (o += c.length) - c.length);
+    return { ok: true, status: r.status, bytes: bytes.buffer };
+  } catch (e) {
+    throw abort.signal.aborted ? new StalledError(`nothing arrived for ${seconds} s`) : e;
+  } finally {
+    clearTimeout(timer);
+  }
+}
