@@ -142,22 +142,26 @@ export class TalkingHeadDriver {
 /**
  * A take as TalkingHead's animation template for `speakAudio({ audio, anim })` (Appendix F): `dt` in ms per step,
  * `vs` the values per step by name. TalkingHead prepends the current value to each track and keys value k at the
- * sum of dt[0..k], so dt[0] is 0 (frame 0 at the start of the audio) and the rest 1000 / fps. Shapes that stay 0
- * throughout are left out.
+ * sum of dt[0..k]. So that the take blends in from what TalkingHead showed, as the driver's does (BLEND_IN), the
+ * frames before 0.12 s are left out and dt[0] is the first kept frame's time: TalkingHead eases from its current
+ * value to that frame over those 0.12 s, and every frame k after is shown k / fps after the audio starts (dt 1000 /
+ * fps). Shapes that stay 0 throughout are left out.
  */
 export function talkingHeadAnim(animation: Animation, options: TalkingHeadOptions = {}): { name: string; dt: number[]; vs: Record<string, number[]> } {
   const b = blendshapesOf(animation);
   const F = animation.frames;
   const A = ARKIT_NAMES.length;
+  const first = Math.max(0, Math.min(Math.ceil(BLEND_IN * animation.fps), F - 1));
+  const frames = Array.from({ length: F - first }, (_, i) => first + i);
   const round = (x: number) => Math.round(x * 1e5) / 1e5;
   const vs: Record<string, number[]> = {};
   for (const name of options.shapes ?? TALKINGHEAD_SHAPES) {
-    const track = Array.from({ length: F }, (_, f) => round(b.arkit[f * A + ARKIT_INDEX[name]]));
+    const track = frames.map((f) => round(b.arkit[f * A + ARKIT_INDEX[name]]));
     if (track.some((x) => x > 0)) vs[name] = track;
   }
   if (options.head ?? true) {
-    const angles = Array.from({ length: F }, (_, f) => talkingHeadAngles(b.headRotation[3 * f], b.headRotation[3 * f + 1], b.headRotation[3 * f + 2]));
+    const angles = frames.map((f) => talkingHeadAngles(b.headRotation[3 * f], b.headRotation[3 * f + 1], b.headRotation[3 * f + 2]));
     TALKINGHEAD_HEAD.forEach((name, k) => (vs[name] = angles.map((a) => round(a[k]))));
   }
-  return { name: 'blendshapes', dt: Array.from({ length: F }, (_, f) => (f === 0 ? 0 : 1000 / animation.fps)), vs };
+  return { name: 'blendshapes', dt: frames.map((f, i) => (i === 0 ? f : 1) * 1000 / animation.fps), vs };
 }

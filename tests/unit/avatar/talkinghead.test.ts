@@ -122,14 +122,15 @@ describe('talkingHeadAngles', () => {
 });
 
 describe('talkingHeadAnim', () => {
-  it('the shapes that move and the head, dt 0 then 1000 / fps', () => {
+  it('the shapes that move and the head from the first frame at 0.12 s or after, keyed at its time, then 1000 / fps', () => {
     const a = talkingHeadAnim(take());
     expect(a.name).toBe('blendshapes');
-    expect(a.dt).toHaveLength(40);
-    expect(a.dt[0]).toBe(0);
+    expect(a.dt).toHaveLength(36); // frames 4 to 39: the take blends in from TalkingHead's own values until frame 4
+    expect(a.dt[0]).toBeCloseTo(4000 / 30, 9);
     expect(a.dt[1]).toBeCloseTo(1000 / 30, 9);
     expect(Object.keys(a.vs).sort()).toEqual(['headRotateX', 'headRotateY', 'headRotateZ', 'jawOpen', 'mouthRight']); // no eyeBlinkLeft
-    expect(a.vs.jawOpen[10]).toBeCloseTo(0.25, 5);
+    expect(a.vs.jawOpen[10 - 4]).toBeCloseTo(0.25, 5);
+    expect(talkingHeadAnim({ ...take(), frames: 2 }).dt).toEqual([1000 / 30]); // a take shorter than the blend: its last frame
     expect(() => talkingHeadAnim({ ...take(), blendshapes: undefined })).toThrow(/animate with \{ blendshapes: true \}/);
   });
 });
@@ -201,5 +202,23 @@ describe('TalkingHead 1.7.0 itself (in Node) with the test avatars', () => {
       if (k % 7 === 0 || k === t.frames - 1) expect(influence('jawOpen'), `frame ${k}`).toBeCloseTo(k / 40, 3);
     }
     expect(influence('mouthRight')).toBeCloseTo(0.5, 3);
+  });
+
+  it("blends speakAudio's anim in from what TalkingHead showed over 0.12 s, not a jump at its first frame", async () => {
+    head = await talkingHeadInNode(); // a TalkingHead of its own: another's speakAudio waits for the last take's audio to end
+    await head.showAvatar({ url: avatarUrl('arkit-full-body.glb'), body: 'M', avatarMood: 'neutral' });
+    step(30);
+    const t = take();
+    const jaw = ARKIT_NAMES.indexOf('jawOpen');
+    for (let f = 0; f < t.frames; f++) t.blendshapes!.arkit[f * 52 + jaw] = 0.6;
+    const before = influence('jawOpen');
+    head.speakAudio({ audio: { duration: t.frames / t.fps }, anim: talkingHeadAnim(t) }, { isRaw: true });
+    await new Promise((r) => setTimeout(r, 0)); // startSpeaking and playAudio are async
+    expect(head.animQueue.some((a) => a.template.name === 'blendshapes')).toBe(true);
+    const seen = Array.from({ length: 6 }, () => (step(), influence('jawOpen')));
+    expect(before).toBeLessThan(0.05);
+    expect(seen[0], 'one step in').toBeLessThan(0.35);
+    for (let k = 1; k < 4; k++) expect(seen[k], `step ${k + 1}`).toBeGreaterThan(seen[k - 1]);
+    expect(seen[5]).toBeCloseTo(0.6, 2);
   });
 });
