@@ -4,14 +4,18 @@
  * The head: front, three-quarter and profile at rest, the mouth open on a vowel, the lips closed on /m/, idle.
  */
 import { chromium, type Browser, type Page } from '@playwright/test';
-import { spawn, execSync } from 'node:child_process';
+import { execSync } from 'node:child_process';
 import { mkdirSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { fakeMicrophone, reportGpuRenderer } from '../playwright.config';
+import { envPort, portFree, readOptions, startServer } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const OUT = resolve(ROOT, 'docs/screenshots');
-const PORT = Number(process.env.SCREENSHOTS_PORT ?? 4192);
+const USAGE = `npm run screenshots   the demo's main views and the head, in headless Chromium -> docs/screenshots/
+  SCREENSHOTS_PORT=N      serve the build on port N (default 4192; it must be free)`;
+readOptions('screenshots', USAGE, {}); // --help, or a stray option refused before anything is built
+const PORT = envPort('screenshots', USAGE, 'SCREENSHOTS_PORT', 4192);
 const URL_ = `http://127.0.0.1:${PORT}`;
 
 async function ready(page: Page, attr: string, value: string): Promise<void> {
@@ -99,18 +103,13 @@ async function headViews(browser: Browser): Promise<void> {
 }
 
 async function main(): Promise<void> {
+  // Another server on the port would be photographed instead of this build.
+  if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use: free it, or set SCREENSHOTS_PORT`);
   execSync('npm run --silent build', { cwd: ROOT, stdio: 'inherit' });
-  const server = spawn('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
+  const server = startServer('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], ROOT);
   mkdirSync(OUT, { recursive: true });
   try {
-    for (let i = 0; ; i++) {
-      try {
-        if ((await fetch(`${URL_}/`)).ok) break;
-      } catch {
-        if (i > 100) throw new Error('the preview server did not start');
-        await new Promise((r) => setTimeout(r, 200));
-      }
-    }
+    await server.ready(`${URL_}/`);
     const wav = resolve(ROOT, 'tests/fixtures/speech-kal.wav');
     const browser = await chromium.launch(fakeMicrophone(wav));
     await headViews(browser);
@@ -169,11 +168,7 @@ async function main(): Promise<void> {
     await browser.close();
     console.log(`screenshots written to ${OUT}`);
   } finally {
-    try {
-      process.kill(-server.pid!);
-    } catch {
-      /* already gone */
-    }
+    server.stop();
   }
 }
 
