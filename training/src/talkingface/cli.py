@@ -10,6 +10,7 @@ import argparse
 import hashlib
 import os
 import pickle
+import signal
 import sys
 import traceback
 from collections.abc import Callable
@@ -58,12 +59,47 @@ def run_cli(main: Callable[[], int | None]) -> None:
         sys.exit(2)
 
 
+def term_as_interrupt() -> None:
+    """SIGTERM (`timeout`, `kill`, a job scheduler) raised as KeyboardInterrupt, so a trainer saves its checkpoint first,
+    as on Ctrl-C (a job started with & ignores SIGINT, so SIGTERM is what stops it)."""
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+    signal.signal(signal.SIGTERM, interrupt)
+
+
 def require_positive(ap: argparse.ArgumentParser, args: argparse.Namespace, *names: str) -> None:
     """ap.error for any of the options `names` (attribute names) given as zero or less: a budget or size of nothing."""
     for name in names:
         value = getattr(args, name)
         if value is not None and value <= 0:
             ap.error(f"--{name.replace('_', '-')} must be above 0, not {value}")
+
+
+def check_out_file(ap: argparse.ArgumentParser, path: str | Path | None, flag: str = "--out") -> None:
+    """ap.error before any work where `path` cannot be written: it is a folder, or its folder does not exist."""
+    if path is None:
+        return
+    p = Path(path)
+    if p.is_dir():
+        ap.error(f"{flag} {p} is a folder: give a file name")
+    if not p.parent.is_dir():
+        ap.error(f"{flag} {p}: the folder {p.parent} does not exist")
+
+
+def npz_path(path: str | Path) -> Path:
+    """The name numpy's savez gives `path` (it adds .npz to a name without it), so it is reported and found again."""
+    p = Path(path)
+    return p if p.suffix == ".npz" else p.with_name(p.name + ".npz")
+
+
+def check_device(ap: argparse.ArgumentParser, device: str) -> None:
+    """ap.error for a --device torch does not know, or a CUDA device on a machine without one."""
+    try:
+        kind = torch.device(device).type
+    except RuntimeError:
+        ap.error(f"--device {device}: not a torch device (cpu, cuda, cuda:1)")
+    if kind == "cuda" and not torch.cuda.is_available():
+        ap.error(f"--device {device}: PyTorch sees no CUDA device here; train with --device cpu")
 
 
 def made_from(*files: str | Path, text: str = "") -> str:

@@ -35,7 +35,7 @@ from .fixtures import fixture_audio, write_fixtures
 from .model.gava import TalkingFace
 from .model.head_motion import HeadMotion
 from .model.lip_closure import LipClosure
-from .paths import MODELS_DIR
+from .paths import MODELS_DIR, REPO_ROOT, TEMPLATE_DIR
 from .phones import CONTENT_CLASSES
 from .safetensors import sha256, write_safetensors
 from .cli import read_checkpoint
@@ -301,8 +301,11 @@ def main(argv=None) -> int:
         return 2
     ck = read_checkpoint(args.checkpoint)
     m = export(args.checkpoint, args.out, load_template(args.template, args.masks) if args.template else None, ck)
-    named = args.template or Path(ck.get("template_path", ""))
-    if said := copy_template(named if str(named) else None, args.out):
+    # The template the model was exported with (checkpoint_template's choice): the recorded one where it is on this
+    # machine, else the shipped one (which export checked has the recorded id).
+    recorded = Path(ck.get("template_path", ""))
+    named = args.template or next((p for p in (recorded, REPO_ROOT / recorded) if str(recorded) and p.is_file()), TEMPLATE_DIR / "template.json")
+    if said := copy_template(named, args.out):
         print(said, file=sys.stderr)
     print(f"exported {m['model']['name']} ({m['model']['parameters']:,} parameters): runtime files {m['runtime_bytes'] / 1e6:.2f} MB -> {args.out}")
     return 0

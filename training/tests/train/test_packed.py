@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import torch
 
+from talkingface.data.datasets import DatasetError
 from talkingface.features import AudioConfig
 from talkingface.paths import REPO_ROOT as REPO
 from talkingface.train import packed, train
@@ -66,12 +67,18 @@ def test_a_packed_run_trains_as_a_run_on_the_dataset(corpus, packed_file, tmp_pa
     assert model.num_vertices == corpus.template.num_vertices
 
 
-def test_bad_packed_files_are_named(tmp_path, capsys):
-    with pytest.raises(SystemExit, match="does not exist"):
+def test_bad_packed_files_are_named(packed_file, tmp_path, capsys):
+    with pytest.raises(DatasetError, match="does not exist"):
         packed.load(tmp_path / "none.npz")
+    with pytest.raises(DatasetError, match="is a folder"):
+        packed.load(tmp_path)
     np.savez(tmp_path / "other.npz", x=np.zeros(3))
-    with pytest.raises(SystemExit, match="not a file of packed clips"):
-        packed.load(tmp_path / "other.npz")
+    np.save(tmp_path / "bare.npy", np.zeros(3))
+    (tmp_path / "meta.json").write_text("{}")
+    (tmp_path / "cut.npz").write_bytes(packed_file.read_bytes()[:300_000])
+    for name in ("other.npz", "bare.npy", "meta.json", "cut.npz"):  # another .npz, a bare array, not numpy's, cut short
+        with pytest.raises(DatasetError, match="not a file of packed clips"):
+            packed.load(tmp_path / name)
     with pytest.raises(SystemExit):
         train.main(["--packed", str(tmp_path / "other.npz"), "--corpus", "x", "--out", str(tmp_path / "r"), "--steps", "1"])
     assert "not allowed with argument" in capsys.readouterr().err
@@ -87,10 +94,11 @@ def test_cuda_is_refused_where_there_is_none(packed_file, tmp_path, capsys):
 def test_the_gpu_script_trains_its_recipes(packed_file, tmp_path):
     """scripts/face-gpu.sh on the CPU: each recipe's model (without the optimiser) and log come back in a tar."""
     recipes = tmp_path / "recipes.txt"
-    recipes.write_text("# a comment\nquick --batch-clips 2 --frames 4   # trailing comment\n\nwrong --no-such-option\n")
+    # the last line without its newline; run from another folder, with a relative OUT
+    recipes.write_text("# a comment\nwrong --no-such-option\n\nquick --batch-clips 2 --frames 4   # trailing comment")
     env = {**os.environ, "DEVICE": "cpu", "PYTHON": sys.executable, "OMP_NUM_THREADS": "1"}
-    run = subprocess.run([str(REPO / "scripts" / "face-gpu.sh"), str(packed_file), str(tmp_path / "out"), "0.02", str(recipes)],
-                         cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
+    run = subprocess.run([str(REPO / "scripts" / "face-gpu.sh"), str(packed_file), "out", "0.02", str(recipes)],
+                         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert run.returncode == 1 and "no model from: wrong" in run.stderr, run.stderr
     with tarfile.open(tmp_path / "out" / "wrong.tar") as tar:
         assert tar.getnames() == ["wrong.log"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import zipfile
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..cli import npz_path
 from ..data.datasets import DatasetError
 
 CROP = 300           # Mel frames per crop (3 s)
@@ -164,7 +166,7 @@ def unpack(path: Path) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
     try:
         z = np.load(path)
         lo, hi = z["range"]
-    except (ValueError, KeyError, OSError) as e:  # a pickle, another .npz, not numpy's at all
+    except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile) as e:  # a pickle, another .npz, one cut short, not numpy's at all
         raise DatasetError(f"{path} is not a packed speech bank (talkingface.frontend.bank's .npz): {e}") from e
     out = {}
     for name in sorted({k.rsplit("_", 1)[0] for k in z.files if k.endswith("_lengths")}):
@@ -185,6 +187,9 @@ def main(argv=None) -> int:
     ap.add_argument("--no-corpus-train", action="store_true", help="leave out the mesh corpus's train split")
     ap.add_argument("--out", type=Path, required=True, help="the packed file (.npz); frontend.train --packed reads it")
     args = ap.parse_args(argv)
+    if args.out.is_dir():
+        ap.error(f"--out {args.out} is a folder: give a file name")
+    args.out = npz_path(args.out)  # numpy adds .npz to a name without it
     audio = AudioConfig()
     train, held = read_speech(args.speech, args.corpus, args.no_corpus_train, audio)
     counts = pack(args.out, train, held)

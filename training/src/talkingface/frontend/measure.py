@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..cli import dataset_of, dataset_options
+from ..cli import check_out_file, dataset_of, dataset_options
 from ..features import AudioConfig, warp_mel
 from ..model.config import ModelConfig
 from ..model.encoders import ContentEncoder
@@ -130,6 +130,7 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path, help="also write the figures here (JSON)")
     dataset_options(ap)
     args = ap.parse_args(argv)
+    check_out_file(ap, args.out)
     args.split = [s for s in args.split.split(",") if s]
     try:
         warps = tuple(float(w) for w in args.warps.split(","))

@@ -22,7 +22,7 @@ import sys
 
 import torch
 
-from ..cli import read_checkpoint
+from ..cli import check_out_file, read_checkpoint
 from ..model.encoders import ContentEncoder
 from ..train.train import load_frontend
 
@@ -73,6 +73,7 @@ def main(argv=None) -> int:
     ap.add_argument("--face", help="write this face checkpoint with the result as its content encoder, not a front-end file")
     ap.add_argument("--out", required=True)
     args = ap.parse_args(argv)
+    check_out_file(ap, args.out)
     tuned = load_frontend(args.tuned)
     base = with_look_ahead_of(load_frontend(args.base), tuned)
     try:

@@ -25,7 +25,7 @@ import numpy as np
 import torch
 import torch.nn.functional as F
 
-from ..cli import check_run_folder, require_positive
+from ..cli import check_device, check_run_folder, require_positive, term_as_interrupt
 from ..data.datasets import open_dataset
 from ..features import AudioConfig
 from ..model.config import ModelConfig
@@ -196,8 +196,7 @@ def main(argv=None) -> int:
         ap.error(f"--timbre: a fraction of the crops, between 0 and 1, not {args.timbre}")
     require_positive(ap, args, "minutes", "steps", "batch", "threads", "eval_every")
     check_run_folder(ap, args.out, args.resume, "checkpoint.pt", "frontend.pt")
-    if args.device.startswith("cuda") and not torch.cuda.is_available():
-        raise SystemExit(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
+    check_device(ap, args.device)
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
     rng = np.random.default_rng(args.seed)
@@ -248,6 +247,8 @@ def main(argv=None) -> int:
     ck_path = args.out / "checkpoint.pt"
     if args.resume:
         ck = torch.load(ck_path, map_location="cpu", weights_only=False)
+        if ck["model_config"] != cfg.to_dict():
+            raise SystemExit(f"--resume: {ck_path} is a {ck['model_config']} front-end, not {cfg.to_dict()} (give the run's own options)")
         enc.load_state_dict(ck["content"])
         enc.to(args.device)
         opt.load_state_dict(ck["optimizer"])
@@ -264,6 +265,7 @@ def main(argv=None) -> int:
         torch.save(payload, path.with_suffix(".tmp"))
         os.replace(path.with_suffix(".tmp"), path)
 
+    term_as_interrupt()  # a SIGTERM (timeout, a job scheduler) saves the checkpoint as Ctrl-C does
     start = time.time() - trained
     losses = []
     progress = (lambda: step / args.steps) if args.steps is not None else (lambda: trained / (60 * args.minutes))

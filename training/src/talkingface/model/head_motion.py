@@ -262,7 +262,8 @@ def motion_stats(tracks: list[np.ndarray]) -> dict:
 
 def main(argv=None) -> int:
     import torch
-    from ..cli import dataset_of, dataset_options, made_from
+    from ..cli import check_out_file, dataset_of, dataset_options, made_from, npz_path
+    from .residual_cache import cached
     from ..train.train import load_checkpoint
     ap = argparse.ArgumentParser(prog="python -m talkingface.model.head_motion", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -277,25 +278,18 @@ def main(argv=None) -> int:
                     "not the geometric mean over speakers")
     dataset_options(ap)
     args = ap.parse_args(argv)
-    model, ck = load_checkpoint(args.checkpoint)
-    model.eval()
+    check_out_file(ap, args.out)
+    if args.cache:
+        check_out_file(ap, args.cache, "--cache")
+        args.cache = npz_path(args.cache)  # numpy adds .npz to a name without it: found again by that name
     ds = dataset_of(args)
+    model, ck = load_checkpoint(args.checkpoint, ds.template)
+    model.eval()
 
     progress = lambda i, n: (i % 50 == 0 or i == n) and print(f"  {i}/{n} clips", file=sys.stderr)
     source = made_from(args.checkpoint, args.corpus, text="\n".join(ds.keys("train")))  # what the residuals depend on
-    if args.cache and args.cache.exists():
-        data = np.load(args.cache)
-        if not ("made_from" in data and str(data["made_from"]) == source and bool(data["against_mean"]) == args.against_mean):
-            raise SystemExit(f"{args.cache} was made from another corpus or checkpoint, with the other --against-mean, or by "
-                             "an earlier version: delete it or give another --cache")
-        n = int(data["clips"])
-        residuals, feats, speakers = [data[f"r{i}"] for i in range(n)], [data[f"f{i}"] for i in range(n)], data["speakers"].tolist()
-        sources = data["sources"].tolist()
-    else:
-        residuals, feats, speakers, sources = collect(model, ds, "train", progress, args.against_mean)
-        if args.cache:
-            np.savez(args.cache, clips=len(residuals), speakers=np.array(speakers), sources=np.array(sources), against_mean=args.against_mean,
-                     made_from=source, **{f"r{i}": r for i, r in enumerate(residuals)}, **{f"f{i}": f for i, f in enumerate(feats)})
+    residuals, feats, speakers, sources = cached(args.cache, source, args.against_mean,
+                                                 lambda: collect(model, ds, "train", progress, args.against_mean))
     from ..corpus.clip import neck_pivot
     template_mm = ds.template.vertices.astype(np.float64) * ds.mm_per_unit
     hm = fit(residuals, feats, neck_pivot(template_mm, ds.template), None if args.no_speech else args.ridge,

@@ -182,7 +182,7 @@ def fit(segments, template: Template, lo: float = 2.0, hi: float = 12.0, mouth_g
 
 def main(argv=None) -> int:
     import torch
-    from ..cli import dataset_of, dataset_options
+    from ..cli import check_out_file, dataset_of, dataset_options
     from ..train.train import load_checkpoint
     ap = argparse.ArgumentParser(prog="python -m talkingface.model.lip_closure", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -194,14 +194,18 @@ def main(argv=None) -> int:
                     "before closing (default: the checkpoint's, else 1; chosen on val: docs/results/README.md)")
     dataset_options(ap)
     args = ap.parse_args(argv)
+    if args.mouth_gain is not None and not 0.5 <= args.mouth_gain <= 2.0:
+        ap.error(f"--mouth-gain {args.mouth_gain}: expected a factor between 0.5 and 2")
+    check_out_file(ap, args.out)
     torch.set_num_threads(1)
     ds = dataset_of(args)
     model, ck = load_checkpoint(args.checkpoint, ds.template)
     model.eval()
-    segs = heard_bilabials(model, ds, args.split, lambda i, n: i % 20 == 0 and print(f"  {i}/{n} clips", file=sys.stderr))
     gain = args.mouth_gain if args.mouth_gain is not None else float((ck.get("lip_closure") or {}).get("mouth_gain", 1.0))
-    if not 0.5 <= gain <= 2.0:
-        raise SystemExit(f"--mouth-gain {gain}: expected a factor between 0.5 and 2")
+    segs = heard_bilabials(model, ds, args.split, lambda i, n: i % 20 == 0 and print(f"  {i}/{n} clips", file=sys.stderr))
+    if not segs:  # the median of nothing: a reference gap at the bisection's bound, written as if calibrated
+        raise SystemExit(f"the front-end heard no /p b m/ segment on the {args.split} split, so there is nothing to calibrate the "
+                         "closure on: is the model trained (and the split the one its voices are unheard in)? Nothing written")
     ref, raw = fit(segs, ds.template, mouth_gain=gain)
     train_mean, n = reference_gap(ds, "train")
     ck["lip_closure"] = {"reference_gap_mm": ref, "mouth_gain": gain, "split": args.split, "segments": len(segs),

@@ -179,6 +179,10 @@ def main(argv=None) -> int:
         out_dir = Path(args.out).parent
         if out_dir.exists() and not out_dir.is_dir():
             ap.error(f"--out {args.out}: {out_dir} is a file, not a folder")
+        if Path(args.out).is_dir():
+            ap.error(f"--out {args.out} is a folder: give the JSON file's name")
+        if Path(args.out).suffix in (".md", ".png"):
+            ap.error(f"--out {args.out}: the JSON's name (the report is written beside it as .md, the plot as _head_motion.png)")
     if not Path(args.checkpoint).is_file():
         ap.error(f"--checkpoint {args.checkpoint} does not exist")
     ds = dataset_of(args)

@@ -1,5 +1,5 @@
-"""A dataset's training clips packed into one file, for training the face where the dataset is not (a GPU machine
-that takes a few tens of MiB): what `data.prepare` makes of each clip, the faces compressed.
+"""A dataset's training clips (its train split) packed into one file, for training the face where the dataset is not
+(a GPU machine that takes a few tens of MiB): what `data.prepare` makes of each clip, the faces compressed.
 
   scripts/py -m talkingface.train.packed --corpus data/corpus --out runs/facegpu/train.npz      # about 30 MiB
   python -m talkingface.train.train --packed runs/facegpu/train.npz --device cuda --out ... (the usual options)
@@ -15,11 +15,13 @@ from __future__ import annotations
 import argparse
 import pickle
 import sys
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
-from ..data.datasets import open_dataset
+from ..cli import npz_path
+from ..data.datasets import DatasetError, open_dataset
 from ..features import AudioConfig
 from ..template import Template
 from .data import PreparedClip, prepare
@@ -68,16 +70,23 @@ def pack(clips: list[PreparedClip], template: Template, template_path: str, fps:
 
 
 def load(path: str | Path) -> tuple[list[PreparedClip], Template, str, float]:
-    """-> (clips, template, the dataset's template path, fps) from a file `pack` wrote."""
+    """-> (clips, template, the dataset's template path, fps) from a file `pack` wrote (DatasetError: it is not one)."""
     path = Path(path)
     if not path.is_file():
-        raise SystemExit(f"--packed: {path} does not exist")
-    with np.load(path, allow_pickle=False) as z:
-        if "format" not in z or str(z["format"]) != FORMAT:
-            raise SystemExit(f"--packed: {path} is not a file of packed clips (talkingface.train.packed writes them)")
-        if int(z["version"]) != VERSION:
-            raise SystemExit(f"--packed: {path} is version {int(z['version'])}; this toolkit reads {VERSION}: pack it again")
-        f = {k: z[k] for k in z.files}
+        raise DatasetError(f"--packed: {path} {'is a folder, not a file' if path.is_dir() else 'does not exist'}")
+    not_packed = f"--packed: {path} is not a file of packed clips (talkingface.train.packed writes them)"
+    try:
+        z = np.load(path, allow_pickle=False)
+        if not isinstance(z, np.lib.npyio.NpzFile):  # a bare array (.npy)
+            raise DatasetError(not_packed)
+        with z:
+            if "format" not in z or str(z["format"]) != FORMAT:
+                raise DatasetError(not_packed)
+            if int(z["version"]) != VERSION:
+                raise DatasetError(f"--packed: {path} is version {int(z['version'])}; this toolkit reads {VERSION}: pack it again")
+            f = {k: z[k] for k in z.files}
+    except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile) as e:  # a pickle, not numpy's at all, one cut short
+        raise DatasetError(f"{not_packed}: {e}") from e
     template = pickle.loads(f["template"].tobytes())
     n = template.num_vertices
     faces = (f["coef"].astype(np.float32) * f["scale"]) @ f["basis"] + f["mean"]  # (frames, N*3)
@@ -98,22 +107,23 @@ def main(argv=None) -> int:
     ap.add_argument("--corpus", required=True, help="dataset folder (our corpus, processed VOCASET or Multiface)")
     ap.add_argument("--template", help="template for a real dataset (as train.train's --template)")
     ap.add_argument("--masks", help="region masks for a mesh template")
-    ap.add_argument("--split", default="train", choices=["train", "val", "test"])
     ap.add_argument("--components", type=int, default=128, help="principal directions the faces are kept in")
     ap.add_argument("--out", required=True, help="the .npz file to write")
     args = ap.parse_args(argv)
     if args.components < 1:
         ap.error("--components must be at least 1")
+    if Path(args.out).is_dir():
+        ap.error(f"--out {args.out} is a folder: give a file name")
+    out = npz_path(args.out)  # numpy adds .npz to a name without it
     ds = open_dataset(args.corpus, args.template, args.masks)
     audio = AudioConfig(fps=int(ds.fps))
-    keys = ds.keys(args.split)
+    keys = ds.keys("train")
     clips = []
     for i, k in enumerate(keys):
         clips.append(prepare(ds, k, audio))
         if (i + 1) % 50 == 0 or i + 1 == len(keys):
             print(f"prepared {i + 1} / {len(keys)} clips", file=sys.stderr, flush=True)
     template_path = args.template or str(Path(args.corpus) / "template" / "template.json")
-    out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     err = pack(clips, ds.template, template_path, ds.fps, out, args.components)
     print(f"{out}: {len(clips)} clips, {sum(c.num_frames for c in clips)} frames, {out.stat().st_size / 2**20:.1f} MiB; "

@@ -29,7 +29,7 @@ from ..model import lip_closure as lc
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from ..paths import REPO_ROOT, TEMPLATE_DIR
-from ..cli import check_run_folder, read_checkpoint, require_positive
+from ..cli import CheckpointError, check_device, check_run_folder, read_checkpoint, require_positive, term_as_interrupt
 from ..template import Template, TemplateFormatError, load_template
 from . import packed
 from .data import attach_rest_faces, mel_statistics, prepare, sample_batch
@@ -65,7 +65,7 @@ def model_of(ck: dict, template: Template | None = None, name: str | Path = "the
     if template is None:
         template = checkpoint_template(ck)
     if template.id != ck["template_id"]:
-        raise ValueError(f"{name} was trained on template {ck['template_id']}, not {template.id}")
+        raise CheckpointError(f"{name} was trained on template {ck['template_id']}, not {template.id}: every template needs its own model")
     model = TalkingFace(cfg, template, audio)
     model.load_state_dict(ck["model"])
     return model, ck
@@ -135,10 +135,9 @@ def parse_args(argv=None) -> argparse.Namespace:
         ap.error("--content-warp LO HI: factors with 0.5 < LO <= HI < 2, e.g. 1.12 1.22")
     if args.packed and (args.template or args.masks):
         ap.error("--template and --masks are packed with the clips: give them to train.packed")
+    check_device(ap, args.device)
     if args.lip_closure and args.device != "cpu":
         ap.error("--lip-closure retargets each face on the CPU: train with --device cpu")
-    if args.device.startswith("cuda") and not torch.cuda.is_available():
-        ap.error(f"--device {args.device}: PyTorch sees no CUDA device here; train with --device cpu")
     return args
 
 
@@ -146,8 +145,12 @@ def main(argv=None) -> int:
     args = parse_args(argv)
     distributed = int(os.environ.get("WORLD_SIZE", "1")) > 1
     rank = 0
-    if distributed:
-        dist.init_process_group("gloo" if not torch.cuda.is_available() else "nccl")
+    if distributed:  # NCCL between GPUs, one each (LOCAL_RANK); gloo between CPU processes
+        cuda = args.device.startswith("cuda")
+        if cuda:
+            args.device = f"cuda:{int(os.environ.get('LOCAL_RANK', '0'))}"
+            torch.cuda.set_device(args.device)
+        dist.init_process_group("nccl" if cuda else "gloo")
         rank = dist.get_rank()
     world = dist.get_world_size() if distributed else 1
     torch.set_num_threads(args.threads or max(1, (os.cpu_count() or 1) // world))
@@ -197,6 +200,8 @@ def main(argv=None) -> int:
         weights = {k: v for k, v in init["model"].items() if not (frontend and k.startswith("content."))}
         missing, unexpected = model.load_state_dict(weights, strict=False)
         replaced = lambda k: bool(frontend) and k.startswith("content.")
+        if init["template_id"] != template.id:
+            raise SystemExit(f"--init: {args.init} was trained on template {init['template_id']}, not this dataset's {template.id}")
         if unexpected or any(not (k.startswith("hierarchical.shape_in.") or k == "reference" or replaced(k)) for k in missing):
             raise SystemExit(f"--init: {args.init} does not fit: missing {missing}, unexpected {unexpected}")
         moved = f", its window moved to {cfg.window_future} frames ahead" if init_cfg["window_future"] != cfg.window_future else ""
@@ -220,7 +225,8 @@ def main(argv=None) -> int:
         opt.load_state_dict(ck["optimizer"])
         step, trained_seconds = ck["step"], ck["trained_seconds"]
         log(f"resumed at step {step} ({trained_seconds / 60:.1f} min trained)")
-    net = torch.nn.parallel.DistributedDataParallel(model) if distributed else model
+    net = torch.nn.parallel.DistributedDataParallel(model, device_ids=[torch.device(args.device).index] if args.device.startswith("cuda") else None) \
+        if distributed else model
     log(f"{count_parameters(model):,} parameters ({count_parameters(model) * 4 / 1e6:.2f} MB float32)")
 
     eye, lips, pairs = (torch.from_numpy(f(template)).to(args.device) for f in (eye_region, lip_region, inner_lip_pairs))
@@ -248,6 +254,7 @@ def main(argv=None) -> int:
         return {**out_, "offsets": o, "unposed": unposed, "vertices": apply_pose(unposed, out_["pose"])}
 
     history = []
+    term_as_interrupt()  # a SIGTERM (timeout, a job scheduler) saves the checkpoint as Ctrl-C does
     start = time.time() - trained_seconds
     model.train()
     try:
@@ -255,7 +262,7 @@ def main(argv=None) -> int:
             trained_seconds = time.time() - start
             done = (budget_steps is not None and step >= budget_steps) or (args.minutes is not None and trained_seconds >= 60 * args.minutes)
             if distributed:  # every process stops at the same step
-                flag = torch.tensor([1.0 if done else 0.0])
+                flag = torch.tensor([1.0 if done else 0.0], device=args.device)
                 dist.all_reduce(flag, op=dist.ReduceOp.MAX)
                 done = flag.item() > 0
             if done:
