@@ -127,8 +127,9 @@ test('a TalkingHead avatar speaks with the per-frame weights, in sync with the a
   }, [...TALKINGHEAD_SHAPES, 'headRotateX', 'headRotateY', 'headRotateZ']);
   expect(released.every((r) => r === null), 'released to TalkingHead').toBe(true);
 
-  // 2. Through speakAudio: TalkingHead plays the audio and the anim on its own clock. Between the keys of frames k
-  // and k + 1 it eases from one to the other: each influence lies between the two frames' weights.
+  // 2. Through speakAudio: TalkingHead plays the audio and the anim on its own clock. Past the blend-in (the anim's
+  // first key is the first frame at 0.12 s or after, talkingHeadAnim), between the keys of frames k and k + 1 it eases
+  // from one to the other: each influence lies between the two frames' weights.
   await startSampling(page, CHECKED);
   await page.locator('#speak-anim').click();
   await expect.poll(() => page.evaluate(() => (globalThis as unknown as { samples: Sample[] }).samples.some((s) => s.animTime !== null)), { timeout: 10_000 }).toBe(true);
@@ -136,7 +137,7 @@ test('a TalkingHead avatar speaks with the per-frame weights, in sync with the a
     const g = globalThis as unknown as { samples: Sample[] };
     return g.samples.length > 0 && g.samples[g.samples.length - 1].animTime === null;
   }), { timeout: 30_000, message: "the anim ends" }).toBe(true);
-  const animSamples = (await stopSampling(page)).filter((s) => s.animTime !== null && s.animTime >= 0 && s.animTime < ((take.frames - 1) * 1000) / take.fps);
+  const animSamples = (await stopSampling(page)).filter((s) => s.animTime !== null && s.animTime >= (Math.ceil(0.12 * take.fps) * 1000) / take.fps && s.animTime < ((take.frames - 1) * 1000) / take.fps);
   expect(animSamples.length).toBeGreaterThanOrEqual(8);
   for (const s of animSamples) {
     const k = Math.floor((s.animTime! * take.fps) / 1000);
