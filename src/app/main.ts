@@ -150,10 +150,10 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
 function animateFile(file: File): Promise<void> {
   return animateTake(file.name, async (e, signal) => {
     showStatus(`Decoding ${file.name}…`);
-    const audio = await decodeAudio(file, e.manifest.audio.sample_rate);
+    const audio = await decodeAudio(file, e.manifest.audio.sample_rate, signal); // Cancel need not wait for a long decode
     const src = audio.source;
-    ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
     const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
+    ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
     return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
   });
 }

@@ -19,7 +19,22 @@ export interface DecodedAudio {
   source: { decodedRate: number; channels: number; seconds: number };
 }
 
-export async function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
+/**
+ * `input` decoded to mono at `sampleRate`. `signal`: an abort rejects at once (an AbortError), although the browser
+ * goes on decoding in the background (decodeAudioData cannot be stopped; its result is dropped): a long file's
+ * Cancel does not wait for it.
+ */
+export function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number, signal?: AbortSignal): Promise<DecodedAudio> {
+  if (!signal) return decodeNow(input, sampleRate);
+  if (signal.aborted) return Promise.reject(signal.reason);
+  return new Promise((resolve, reject) => {
+    const stop = () => reject(signal.reason);
+    signal.addEventListener('abort', stop, { once: true });
+    decodeNow(input, sampleRate).then(resolve, reject).finally(() => signal.removeEventListener('abort', stop));
+  });
+}
+
+async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
   let buffer: AudioBuffer;
   if (input instanceof AudioBuffer) buffer = input;
   else {

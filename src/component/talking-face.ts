@@ -122,7 +122,7 @@ export class TalkingFaceElement extends HTMLElement {
     let decoded;
     try {
       this.setStatus('Decoding audio…');
-      decoded = await decodeAudio(await audioInput(audio), engine.manifest.audio.sample_rate);
+      decoded = await decodeAudio(await audioInput(audio), engine.manifest.audio.sample_rate, signal);
     } catch (e) {
       if (gen !== this.generation) return;
       throw this.fail('audio', `the audio could not be read: ${(e as Error).message}`);

@@ -24,7 +24,7 @@ export interface PlayerView {
   setRestFace?(rest: Float32Array): void;
 }
 
-/** Longer clips get a note with the expected time (they still work: memory stays bounded). */
+/** Longer clips get a note: they take a while, and their take's memory grows with them (40-50 MB a minute in the demo). */
 export const LONG_CLIP_SECONDS = 120;
 /** Shorter clips get a note, and no speed figure (a few frames measure start-up, not speed). */
 export const SHORT_CLIP_SECONDS = 0.5;
@@ -51,7 +51,7 @@ export function audioNotes(samples: Float32Array, seconds: number, { speech = tr
   if (lv.peak >= SILENT_PEAK && raisedDb > 0) notes.push(`very quiet (peak ${(20 * Math.log10(lv.peak)).toFixed(0)} dBFS): raised by ${raisedDb.toFixed(0)} dB to animate it`);
   if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of the samples are clipped (distorted); the motion may be less accurate`);
   if (seconds < SHORT_CLIP_SECONDS) notes.push(`a very short clip (${seconds.toFixed(2)} s): too short to show much`);
-  if (animating && seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it is animated in chunks with bounded memory; Cancel stops it`);
+  if (animating && seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it takes a while, and the page's memory grows with its length; Cancel stops it`);
   return notes;
 }
 
