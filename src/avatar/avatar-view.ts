@@ -84,7 +84,7 @@ export class AvatarView {
   static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null): Promise<AvatarView> {
     const res = await fetchBody(url).catch((e: Error) => {
       const other = new URL(url, location.href).origin !== location.origin;
-      const hint = e instanceof StalledError ? '; check the connection and try again' : other ? ' (another origin: does it send CORS headers?)' : '';
+      const hint = other && !(e instanceof StalledError) ? ' (another origin: does it send CORS headers?)' : '';
       throw new Error(`could not fetch the avatar ${url}: ${e.message}${hint}`);
     });
     if (!res.ok) throw new Error(`could not fetch the avatar ${url}: HTTP ${res.status}`);

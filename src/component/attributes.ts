@@ -1,7 +1,7 @@
 /** What <talking-face>'s attributes and speak()'s argument mean, checked: a bad value warns and falls back. */
 import { MAX_HEAD_MOTION_SCALE, type Backend } from '../engine/engine';
 import { checkedBackend } from '../engine/checks';
-import { fetchBody, StalledError } from '../model/fetch-body';
+import { fetchBody } from '../model/fetch-body';
 
 /** The `backend` attribute: auto (absent or empty), cpu or webgpu (the engine's names); anything else warns and means auto. */
 export function backendAttribute(value: string | null): 'auto' | Backend {
@@ -36,7 +36,7 @@ export async function audioInput(audio: Blob | AudioBuffer | URL | string): Prom
   const url = new URL(String(audio), document.baseURI);
   const shown = url.origin === location.origin ? url.pathname : url.href;
   const res = await fetchBody(url).catch((e: Error) => {
-    throw new Error(`could not fetch ${shown}: ${e.message}${e instanceof StalledError ? '; check the connection and try again' : ''}`);
+    throw new Error(`could not fetch ${shown}: ${e.message}`);
   });
   if (!res.ok) throw new Error(`could not fetch ${shown}: HTTP ${res.status}`);
   return new Blob([res.bytes]);

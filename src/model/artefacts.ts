@@ -32,9 +32,7 @@ export { STALL_SECONDS } from './fetch-body';
 /** `url`'s bytes, or a ModelLoadError naming `what` (missing, unreachable, or stalled for `stallSeconds`). */
 async function fetchNamed(url: URL, what: string, options: FetchBodyOptions): Promise<ArrayBuffer> {
   const body = await fetchBody(url, options).catch((e: Error) => {
-    throw new ModelLoadError(e instanceof StalledError
-      ? `${what} stalled: ${e.message} (${url}); check the connection and try again`
-      : `could not fetch ${what} (${url}): ${e.message}`);
+    throw new ModelLoadError(e instanceof StalledError ? `${what} stalled: ${e.message} (${url})` : `could not fetch ${what} (${url}): ${e.message}`);
   });
   if (!body.ok) throw new ModelLoadError(`${what} is missing (HTTP ${body.status} for ${url})`);
   return body.bytes;
@@ -51,7 +49,7 @@ export function resolveManifestUrl(url: string | URL | undefined): URL {
 export async function fetchManifest(url: string | URL | undefined, fetchFn: typeof fetch = fetch.bind(globalThis), stallSeconds?: number): Promise<{ manifest: Manifest; manifestUrl: URL }> {
   const manifestUrl = resolveManifestUrl(url);
   const body = await fetchBody(manifestUrl, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
-    throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}${e instanceof StalledError ? '; check the connection and try again' : ''}`);
+    throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}`);
   });
   if (!body.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${body.status}`);
   try {

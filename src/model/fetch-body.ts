@@ -8,7 +8,7 @@
 /** Seconds a download may bring nothing before it fails (the default of every `stallSeconds`). */
 export const STALL_SECONDS = 30;
 
-/** Nothing arrived for `stallSeconds`; the message says so, for the caller to name what was being fetched. */
+/** Nothing arrived for `stallSeconds`; the message says so and what to do, for the caller to name what was being fetched. */
 export class StalledError extends Error {
   override name = 'StalledError';
 }
@@ -35,7 +35,8 @@ export async function fetchBody(url: string | URL, options: FetchBodyOptions = {
     clearTimeout(timer);
     timer = setTimeout(() => abort.abort(), seconds * 1000);
   };
-  const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(`nothing arrived for ${seconds} s`)), { once: true }));
+  const said = `nothing arrived for ${seconds} s; check the connection and try again`;
+  const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(said)), { once: true }));
   stalled.catch(() => undefined); // deliberate: read in the races below, or never needed once the body is in
   try {
     // A fetch that ignores the signal (a page's own fetch function) still cannot hang: the race ends it.
@@ -58,7 +59,7 @@ export async function fetchBody(url: string | URL, options: FetchBodyOptions = {
     for (const c of chunks) bytes.set(c, (o += c.length) - c.length);
     return { ok: true, status: r.status, bytes: bytes.buffer };
   } catch (e) {
-    throw abort.signal.aborted ? new StalledError(`nothing arrived for ${seconds} s`) : e;
+    throw abort.signal.aborted ? new StalledError(said) : e;
   } finally {
     clearTimeout(timer);
   }

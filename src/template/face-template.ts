@@ -11,7 +11,7 @@
  * with `scripts/import-template.ts` loads through the same code.
  */
 import { buildAdjacency, type Adjacency } from './mesh-topology';
-import { fetchBody, StalledError } from '../model/fetch-body';
+import { fetchBody } from '../model/fetch-body';
 
 export const TEMPLATE_FORMAT = 'talking-face-template';
 
@@ -194,7 +194,7 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
 export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch, stallSeconds?: number): Promise<FaceTemplate> {
   const get = async (url: string | URL, what: string) => {
     const body = await fetchBody(url, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
-      throw new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}${e instanceof StalledError ? '; check the connection and try again' : ''}`);
+      throw new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}`);
     });
     if (!body.ok) throw new TemplateFormatError(`could not load ${what} ${url}: HTTP ${body.status}`);
     return body.bytes;
