@@ -16,7 +16,8 @@ import * as THREE from 'three';
 import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
-import { motionBasis, type MotionBasisOptions } from './motion-basis';
+import { motionBasis } from './motion-basis';
+import { slicer, type Slicing } from '../engine/frames';
 import { Head } from '../render/head';
 import { IdleMotion } from '../render/idle-motion';
 
@@ -24,6 +25,8 @@ import { IdleMotion } from '../render/idle-motion';
 export const GLB_EXACT_FRAMES = 1800;
 /** Morph targets in the compact encoding of longer clips. */
 export const GLB_COMPONENTS = 8;
+/** Share of a long clip's export spent posing the head frame by frame (the rest finds its components; measured). */
+const POSING_SHARE = 0.05;
 
 export interface GlbExport {
   bytes: ArrayBuffer;
@@ -35,7 +38,7 @@ export interface GlbExport {
 }
 
 export async function exportGlb(animation: Animation, template: FaceTemplate, unitsPerMm: number, name = 'talking-face',
-  work: Pick<MotionBasisOptions, 'onProgress' | 'signal'> = {}): Promise<GlbExport> {
+  work: Slicing = {}): Promise<GlbExport> {
   if (!animation.unposed) throw new Error('exportGlb: the animation has no unposed frames');
   const frames = animation.frames;
   if (frames < 1) throw new Error('exportGlb: the animation has no frames');
@@ -48,25 +51,31 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   const jaw = new Float32Array(frames * 4);
   const tongue = new Float32Array(frames);
   const q = new THREE.Quaternion();
+  const exact = frames <= GLB_EXACT_FRAMES;
+  const posingShare = exact ? 1 : POSING_SHARE;
+  // Seconds of the page's thread for a long take: in slices, with progress, stopped by the signal.
+  const posing = slicer(frames, { signal: work.signal, onProgress: (d) => work.onProgress?.(posingShare * d) });
   for (let f = 0; f < frames; f++) {
     head.setFace(animation.unposed.subarray(f * n3, (f + 1) * n3), animation.tongue[f] ?? 0);
     const v = head.vertices;
     for (let i = 0; i < dims; i++) D[f * dims + i] = v[i] - base[i];
     head.jaw.quaternion.toArray(jaw, f * 4);
     tongue[f] = animation.tongue[f] ?? 0;
+    await posing();
   }
   const geometry = head.skin.geometry;
   const targets: THREE.BufferAttribute[] = [];
   let weights: Float32Array;
   let maxErrorMm = 0;
-  const exact = frames <= GLB_EXACT_FRAMES;
   if (exact) {
     geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
     for (let f = 0; f < frames; f++) targets.push(new THREE.BufferAttribute(D.subarray(f * dims, (f + 1) * dims), 3));
     weights = new Float32Array(frames * frames);
     for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   } else {
-    const m = await motionBasis(D, frames, dims, GLB_COMPONENTS, work);
+    const m = await motionBasis(D, frames, dims, GLB_COMPONENTS, {
+      signal: work.signal, onProgress: (d) => work.onProgress?.(posingShare + (1 - posingShare) * d),
+    });
     const mean = new Float32Array(dims);
     for (let i = 0; i < dims; i++) mean[i] = base[i] + m.mean[i];
     geometry.setAttribute('position', new THREE.BufferAttribute(mean, 3));

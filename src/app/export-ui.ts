@@ -1,7 +1,7 @@
 /** The demo's exports of a take: a .glb with morph-target animation, or the raw float32 frames. */
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
-import { exportGlb, rawFrames, download, GLB_COMPONENTS, GLB_EXACT_FRAMES } from './export-glb';
+import { exportGlb, rawFrames, download, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
 
 /** The .glb being prepared (a long clip's takes seconds): Escape cancels it (cancelExport). */
@@ -19,7 +19,7 @@ export async function exportGlbFile(animation: Animation, name: string, template
   const controller = (exporting = new AbortController());
   ui.exportGlbButton.setAttribute('aria-busy', 'true');
   try {
-    const preparing = `Preparing the .glb: finding the clip's ${GLB_COMPONENTS} strongest motion components`;
+    const preparing = `Preparing the .glb of ${animation.frames} frames`;
     if (animation.frames > GLB_EXACT_FRAMES) showStatus(`${preparing}… (Escape cancels)`);
     const glb = await exportGlb(animation, template, unitsPerMm, undefined, {
       signal: controller.signal,

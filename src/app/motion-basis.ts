@@ -10,10 +10,7 @@
  * min(frames, fitFrames) x dims x K + frames x dims x K). It yields to the event loop as it goes (a 10-minute clip
  * of the whole head is seconds of work), says how far it is, and stops if its signal is aborted.
  */
-import { yieldToEventLoop } from '../engine/frames';
-
-/** The most the page's thread is held between yields (ms). */
-const YIELD_EVERY_MS = 25;
+import { slicer, type Slicing } from '../engine/frames';
 
 export interface MotionBasis {
   /** (dims) the mean displacement */
@@ -27,14 +24,11 @@ export interface MotionBasis {
   maxError: number;
 }
 
-export interface MotionBasisOptions {
+export interface MotionBasisOptions extends Slicing {
   /** Rounds of subspace iteration (default 8). */
   iterations?: number;
   /** At most this many frames, evenly spread, find the directions (default 2,048). */
   fitFrames?: number;
-  /** Called now and then with the share of the work done, 0 to 1. */
-  onProgress?: (done: number) => void;
-  signal?: AbortSignal;
 }
 
 /** D: frames x dims displacements (row-major), dims a multiple of 3 (points). */
@@ -44,20 +38,15 @@ export async function motionBasis(D: Float32Array, frames: number, dims: number,
   signal?.throwIfAborted();
   K = Math.max(0, Math.min(K, frames, dims));
   const fit = Array.from({ length: Math.min(frames, fitFrames) }, (_, j) => Math.floor((j * frames) / Math.min(frames, fitFrames)));
-  // Work in frame-rows: each round reads the fitted frames twice; the end, every frame twice.
-  const total = iterations * 2 * fit.length + 2 * frames;
-  let done = 0, lastYield = performance.now();
-  const step = async () => {
-    done++;
-    if (performance.now() - lastYield < YIELD_EVERY_MS) return;
-    onProgress?.(done / total);
-    await yieldToEventLoop();
-    signal?.throwIfAborted();
-    lastYield = performance.now();
-  };
+  // Work in frame-rows: the mean reads every frame; each round the fitted frames twice; the end, every frame twice.
+  const total = frames + iterations * 2 * fit.length + 2 * frames;
+  const step = slicer(total, { onProgress, signal });
   const mean = new Float32Array(dims);
   const acc = new Float64Array(dims);
-  for (let f = 0; f < frames; f++) for (let i = 0; i < dims; i++) acc[i] += D[f * dims + i];
+  for (let f = 0; f < frames; f++) {
+    for (let i = 0; i < dims; i++) acc[i] += D[f * dims + i];
+    await step();
+  }
   for (let i = 0; i < dims; i++) mean[i] = acc[i] / Math.max(1, frames);
 
   // Q: K x dims, rows orthonormal. Start from K frames spread over the clip (deterministic).

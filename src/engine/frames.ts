@@ -89,6 +89,30 @@ export function setBlendshapes(all: BlendshapeFrames, chunk: BlendshapeFrames, a
   all.headRotation.set(chunk.headRotation, at * 3);
 }
 
+/** What long work on the page's thread tells and is told: how far it is (0 to 1), and when to stop. */
+export interface Slicing {
+  onProgress?: (done: number) => void;
+  signal?: AbortSignal;
+}
+
+/**
+ * Long work on the page's thread, cut into slices: call the returned step after each of `total` units; once
+ * `sliceMs` have passed since the last yield it reports the share done, yields to the event loop (input, drawing,
+ * timers run) and throws the signal's reason if it was aborted meanwhile.
+ */
+export function slicer(total: number, { onProgress, signal }: Slicing, sliceMs = 25): () => Promise<void> {
+  let done = 0;
+  let last = performance.now();
+  return async () => {
+    done++;
+    if (performance.now() - last < sliceMs) return;
+    onProgress?.(Math.min(1, done / total));
+    await yieldToEventLoop();
+    signal?.throwIfAborted();
+    last = performance.now();
+  };
+}
+
 /** Resolve on a new task (not a microtask): lets the browser handle input, rendering and timers. */
 export function yieldToEventLoop(): Promise<void> {
   return new Promise((resolve) => {

@@ -127,6 +127,14 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
   // The page says what it did (after a progress it shows while the page stays live: seconds of work, more on a busy machine).
   await page.locator('#export-glb').click();
-  await expect(page.locator('#status')).toContainText(/Preparing the \.glb: .*%/);
+  await expect(page.locator('#status')).toContainText(/Preparing the \.glb of \d+ frames: \d+%/);
   await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/, { timeout: 90_000 });
+  // Escape cancels one being prepared: nothing is saved, and the page says so.
+  const saved: string[] = [];
+  page.on('download', (d) => saved.push(d.suggestedFilename()));
+  await page.locator('#export-glb').click();
+  await expect(page.locator('#status')).toContainText(/Preparing the \.glb of \d+ frames: \d+%… \(Escape cancels\)/);
+  await page.keyboard.press('Escape');
+  await expect(page.locator('#status')).toContainText('Export cancelled.');
+  expect(saved).toEqual([]);
 });

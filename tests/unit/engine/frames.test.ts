@@ -1,6 +1,6 @@
 /** joinFrames (src/engine/frames.ts): streamed chunks become one animation, every array in order. */
 import { describe, expect, it } from 'vitest';
-import { emptyBlendshapes, joinFrames, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
+import { emptyBlendshapes, joinFrames, slicer, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
 
 const chunk = (first: number, count: number, n: number): Frames => ({
   count,
@@ -51,5 +51,33 @@ describe('joinFrames', () => {
     void Promise.resolve().then(() => order.push('microtask'));
     await p;
     expect(order).toEqual(['timer', 'microtask', 'yield']);
+  });
+
+  it('slicer: long work yields between slices, says how far it is, and stops when aborted', async () => {
+    const spin = (ms: number) => { const end = performance.now() + ms; while (performance.now() < end); };
+    const seen: number[] = [];
+    let timerRan = false;
+    setTimeout(() => (timerRan = true), 0);
+    const step = slicer(20, { onProgress: (d) => seen.push(d) }, 10);
+    for (let i = 0; i < 20; i++) {
+      spin(4);
+      await step();
+    }
+    expect(timerRan, 'a timer due during the work ran before it ended').toBe(true);
+    expect(seen.length).toBeGreaterThanOrEqual(4);
+    expect(seen.every((d, i) => d > 0 && d <= 1 && (i === 0 || d > seen[i - 1]))).toBe(true);
+    // Aborted meanwhile: the next yield throws the signal's reason.
+    const controller = new AbortController();
+    const stopping = slicer(100, { signal: controller.signal }, 1);
+    let units = 0;
+    const work = (async () => {
+      for (; units < 100; units++) {
+        spin(2);
+        await stopping();
+      }
+    })();
+    setTimeout(() => controller.abort(new Error('cancelled by the visitor')), 0);
+    await expect(work).rejects.toThrow('cancelled by the visitor');
+    expect(units).toBeLessThan(100);
   });
 });
