@@ -10,7 +10,9 @@ import { ContentEncoder } from '../src/encoders/content';
 import { PoseEncoder } from '../src/encoders/pose';
 
 async function main(): Promise<void> {
-  startOrt(['wasm']); // as TalkingFaceEngine.load does without a hardware GPU, before any file has arrived
+  // As TalkingFaceEngine.load does without a hardware GPU, before any file has arrived; ?stallSeconds=N as load's option.
+  const stall = new URLSearchParams(location.search).get('stallSeconds');
+  startOrt(['wasm'], stall ? Number(stall) : undefined);
   const { manifest, files, template } = await fetchArtefacts();
   void template.catch(() => undefined); // fetched as the engine fetches it, not needed here
   await Promise.all([ContentEncoder.create(manifest, files, ['wasm']), PoseEncoder.create(manifest, files, ['wasm'])]);

@@ -6,7 +6,7 @@
  *   const animation = await engine.animate(audio.samples);          // offline, in chunks
  *   const live = await engine.listen(await openMicrophone(), (first, frames) => draw(frames));
  */
-export { TalkingFaceEngine, StreamSession } from './engine/engine';
+export { TalkingFaceEngine, StreamSession, EngineDisposedError } from './engine/engine';
 export type { Backend, EngineOptions, AnimateOptions, Animation, Frames, StageTimes } from './engine/engine';
 export { LiveSession, type LiveOptions } from './engine/live';
 export { decodeAudio, levels, AudioDecodeError, type DecodedAudio } from './audio/decode';

@@ -163,6 +163,7 @@ export class AvatarView {
       for (const m of Array.isArray(mesh.material) ? mesh.material : [mesh.material]) m.dispose();
     });
     this.renderer.dispose();
+    this.renderer.forceContextLoss(); // now, not at garbage collection: a page keeps 16 WebGL contexts at most
   }
 
   private loop = (): void => {

@@ -32,7 +32,11 @@ export function frameOptions(el: Element): { blendshapes: boolean; headMotionSca
 
 /** speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is another origin's). */
 export async function audioInput(audio: Blob | AudioBuffer | URL | string): Promise<Blob | AudioBuffer> {
-  if (!(typeof audio === 'string' || audio instanceof URL)) return audio;
+  if (audio instanceof Blob || (typeof AudioBuffer !== 'undefined' && audio instanceof AudioBuffer)) return audio;
+  if (!(typeof audio === 'string' || audio instanceof URL) || audio === '') {
+    const got = audio === null ? 'null' : audio === '' ? 'an empty string' : typeof audio === 'object' ? (audio as object).constructor?.name ?? 'an object' : typeof audio;
+    throw new TypeError(`speak() takes a Blob or File, an AudioBuffer, or a URL (got ${got})`);
+  }
   const url = new URL(String(audio), document.baseURI);
   const shown = url.origin === location.origin ? url.pathname : url.href;
   const res = await fetchBody(url).catch((e: Error) => {

@@ -34,6 +34,14 @@ export interface TalkingFaceErrorDetail {
   stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar' | 'render';
 }
 
+/** The element's events by name (typed listeners: `face.addEventListener('ready', (e) => e.detail.backend)`). */
+export interface TalkingFaceEventMap extends Omit<HTMLElementEventMap, 'error'> {
+  ready: CustomEvent<ReadyDetail>;
+  frame: CustomEvent<FrameDetail>;
+  ended: Event;
+  error: CustomEvent<TalkingFaceErrorDetail>;
+}
+
 /** A frame of a take being played: its compute time and real-time factor (none for a clip too short to say). */
 export function playbackFrameDetail(engine: TalkingFaceEngine, a: Animation, frame: number, computeMs: number, audioSeconds: number): FrameDetail {
   return {

@@ -15,13 +15,13 @@ canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
  * A canvas for a view. Each view gets a new one: a second WebGL renderer on a canvas whose context a first one used
  * inherits that context's state (pixel-store flags three.js believes unset), and uploads fail.
  */
-export function newCanvas(): HTMLCanvasElement {
+export function newCanvas(name = 'Animated 3D face'): HTMLCanvasElement {
   const canvas = document.createElement('canvas');
   canvas.setAttribute('part', 'canvas');
   canvas.tabIndex = 0;
   canvas.setAttribute('role', 'application'); // the arrow keys are its own (camera-keys.ts), not a screen reader's
   canvas.setAttribute('aria-roledescription', '3D face viewer');
-  canvas.setAttribute('aria-label', `Animated 3D face. ${CAMERA_KEYS_TEXT}.`);
+  canvas.setAttribute('aria-label', `${name}. ${CAMERA_KEYS_TEXT}.`);
   return canvas;
 }
 
@@ -32,9 +32,12 @@ export function newCanvas(): HTMLCanvasElement {
  */
 export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; status: HTMLParagraphElement; announcer: HTMLElement } {
   const root = host.attachShadow({ mode: 'open' });
+  // A group by default, so that a page may name the element (aria-label, which its canvas also takes).
+  const internals = host.attachInternals?.();
+  if (internals) internals.role = 'group';
   const style = document.createElement('style');
   style.textContent = STYLE;
-  const canvas = newCanvas();
+  const canvas = newCanvas(host.getAttribute('aria-label') || undefined);
   const status = document.createElement('p');
   status.className = 'status';
   status.setAttribute('part', 'status');

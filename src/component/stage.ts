@@ -29,12 +29,17 @@ export class ElementStage {
    */
   async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, headBone: string | null): Promise<boolean> {
     const token = (this.token = {});
-    const canvas = newCanvas();
+    const host = (this.canvas.getRootNode() as ShadowRoot).host as HTMLElement | undefined;
+    // The element's own name, where the page gave it one (two faces on a page are told apart).
+    const canvas = newCanvas(host?.getAttribute('aria-label') || undefined);
+    const focused = (this.canvas.getRootNode() as ShadowRoot).activeElement === this.canvas;
     this.canvas.replaceWith(canvas);
     this.canvas = canvas;
+    if (focused) canvas.focus(); // a keyboard user on the face while it loaded stays on it
     canvas.addEventListener('keydown', (ev) => cameraKey(ev, canvas === this.canvas ? this.view : null));
-    canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.onContext(true));
-    canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.onContext(false));
+    // Only while its view is shown: a dropped view's context is given up on purpose (dispose), and that is no loss.
+    canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.view && this.onContext(true));
+    canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.view && this.onContext(false));
     const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, headBone)
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;

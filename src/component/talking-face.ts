@@ -12,14 +12,14 @@ import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { decodeAudio, raiseIfQuiet } from '../audio/decode';
-import { audioInput, backendAttribute, frameOptions } from './attributes';
+import { backendAttribute, frameOptions } from './attributes';
+import { makeTake, TakeError, type ElementTake } from './take';
 import { shadowParts } from './parts';
 import { ElementStage } from './stage';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
-import { sharedEngine } from './engines';
-import { audioNotes, SHORT_CLIP_SECONDS, type PlayerView } from '../player/player';
+import { holdEngine, type EngineHold } from './engines';
+import type { PlayerView } from '../player/player';
 import { liveFrameDetail, playbackFrameDetail, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -35,6 +35,7 @@ export class TalkingFaceElement extends HTMLElement {
   private readonly stage: ElementStage;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
+  private hold: EngineHold | null = null; // on the shared engine (engines.ts): released when removed or switched
   private live: LiveSession | null = null;
   private animation: Animation | null = null;
   private computeMs = 0;
@@ -51,7 +52,10 @@ export class TalkingFaceElement extends HTMLElement {
     [this.statusLine, this.announcer] = [status, announcer];
     this.stage = new ElementStage(canvas, {
       onFrame: (f) => this.playbackFrame(f),
-      onEnded: () => this.dispatchEvent(new CustomEvent('ended')),
+      onEnded: () => {
+        this.setStatus(this.playingStatus.replace(/^Playing/, 'Played')); // the same notes, in the past: it is over
+        this.dispatchEvent(new CustomEvent('ended'));
+      },
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
       onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
       onUnblocked: () => this.setStatus(this.playingStatus),
@@ -79,6 +83,7 @@ export class TalkingFaceElement extends HTMLElement {
   }
 
   connectedCallback(): void {
+    if (this.stage.view && this.engine) return; // moved within the page (disconnectedCallback kept everything)
     [this.connected, this.retrying] = [true, false]; // this call shows the face once loaded
     void this.load().then(
       () => this.afterLoad(),
@@ -87,8 +92,13 @@ export class TalkingFaceElement extends HTMLElement {
   }
 
   disconnectedCallback(): void {
-    this.stop();
-    this.stage.drop();
+    // Moved (removed and put back in the same task, as frameworks and modals do): it goes on playing or listening.
+    queueMicrotask(() => {
+      if (this.isConnected) return;
+      this.stop();
+      this.stage.drop();
+      this.letGo(); // freed ENGINE_LINGER_MS after the last element using it is gone, unless it is put back
+    });
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
@@ -99,10 +109,11 @@ export class TalkingFaceElement extends HTMLElement {
       // (the others keep theirs) and keeps its view (and does not autoplay again); `ready` tells the new backend.
       const anew = name !== 'backend';
       this.stop();
-      [this.loading, this.engine, this.retrying] = [null, null, false];
+      this.letGo();
+      this.retrying = false;
       if (anew) this.stage.drop();
       void this.load().then(() => this.afterLoad(anew), () => undefined); // deliberate: load() reports its failure
-    } else if (name === 'src' && value && this.engine) {
+    } else if (name === 'src' && value) { // set while the model loads: spoken once it is in
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
     } else if (name === 'live' && this.engine) {
@@ -117,47 +128,24 @@ export class TalkingFaceElement extends HTMLElement {
    */
   async speak(audio: Blob | AudioBuffer | URL | string): Promise<void> {
     const { gen, signal } = this.begin();
-    const engine = await this.load();
-    if (gen !== this.generation) return; // stopped (or removed) while the model loaded
-    let decoded;
+    const engine = await this.loadUnless(signal);
+    if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded
+    let take: ElementTake;
     try {
-      this.setStatus('Decoding audio…');
-      decoded = await decodeAudio(await audioInput(audio), engine.manifest.audio.sample_rate, signal);
-    } catch (e) {
-      if (gen !== this.generation) return;
-      throw this.fail('audio', `the audio could not be read: ${(e as Error).message}`);
-    }
-    if (gen !== this.generation) return;
-    const seconds = decoded.samples.length / engine.manifest.audio.sample_rate;
-    const t0 = performance.now();
-    const quiet = raiseIfQuiet(decoded.samples); // quiet speech would be taken for none
-    this.setStatus('Animating…');
-    let animation: Animation, computeMs: number, speech: boolean;
-    try {
-      animation = await engine.animate(quiet.samples, {
-        unposed: true,
-        ...frameOptions(this),
-        signal,
-        onProgress: (done, total) => gen === this.generation && this.setStatus(`Animating: frame ${done} of ${total}…`, false, false),
-      });
-      computeMs = performance.now() - t0;
-      speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
+      take = await makeTake(engine, audio, this, signal, (text, announce) => gen === this.generation && this.setStatus(text, false, announce));
     } catch (e) {
       if (gen !== this.generation) return; // stopped: the abort is no failure
-      throw this.fail('inference', `animation failed: ${(e as Error).message}`);
+      throw e instanceof TakeError ? this.fail(e.stage, e.message) : e;
     }
-    if (gen !== this.generation) return;
     this.work = null; // animated: stop() from here stops the playback
-    const notes = audioNotes(decoded.samples, seconds, { speech, raisedDb: quiet.gainDb });
-    [this.computeMs, this.audioSeconds] = [computeMs, seconds];
+    [this.computeMs, this.audioSeconds] = [take.computeMs, take.seconds];
     const player = await this.stage.settled(); // an avatar may still be loading
     if (gen !== this.generation) return;
     if (!player) throw this.fail('avatar', this.stage.error ?? 'there is no face to show it on (is the element in the page?)');
-    this.animation = animation;
-    player.load(animation, decoded.buffer);
+    this.animation = take.animation;
+    player.load(take.animation, take.decoded.buffer);
     player.show(0);
-    const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
-    this.playingStatus = notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`;
+    this.playingStatus = take.playing;
     this.setStatus(this.playingStatus);
     await player.play(0);
   }
@@ -171,9 +159,9 @@ export class TalkingFaceElement extends HTMLElement {
 
   /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
   async startMicrophone(): Promise<void> {
-    const { gen } = this.begin();
-    const engine = await this.load();
-    if (gen !== this.generation) return; // stopped (or removed) while the model loaded: the microphone stays closed
+    const { gen, signal } = this.begin();
+    const engine = await this.loadUnless(signal);
+    if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded: the microphone stays closed
     let media: MediaStream;
     try {
       media = await openMicrophone();
@@ -227,9 +215,10 @@ export class TalkingFaceElement extends HTMLElement {
       this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
     }
     if (this.live) {
-      const [live, gen] = [this.live, this.generation];
+      const live = this.live;
       this.live = null;
-      void live.stop().then(() => say && gen === this.generation && this.setStatus('Stopped listening.'));
+      if (say) this.setStatus('Stopped listening.'); // the microphone is released at once; the take's end follows
+      void live.stop();
     } else if (say && (wasPlaying || cancelled)) this.setStatus('Stopped.');
   }
 
@@ -243,8 +232,10 @@ export class TalkingFaceElement extends HTMLElement {
     if (!this.loading) {
       const model = this.getAttribute('model') || DEFAULT_MODEL;
       this.setStatus('Loading the model…');
-      this.loading = sharedEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))).then(
+      const hold = (this.hold = holdEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))));
+      this.loading = hold.engine.then(
         (engine) => {
+          if (this.hold !== hold) return engine; // released meanwhile (removed, or another model or backend)
           this.engine = engine;
           // A retry (speak() or startMicrophone() after a failed load): no connectedCallback will show the face.
           if (this.retrying) void this.afterLoad(false, false);
@@ -252,12 +243,24 @@ export class TalkingFaceElement extends HTMLElement {
           return engine;
         },
         (e: Error) => {
-          [this.loading, this.retrying] = [null, true]; // a later call retries
+          if (this.hold === hold) [this.loading, this.hold, this.retrying] = [null, null, true]; // a later call retries
           throw this.fail('model', `the model could not be loaded: ${e.message}`);
         },
       );
     }
     return this.loading;
+  }
+
+  /** The engine, or null as soon as `signal` is aborted (stop() while the model loads: the caller then does nothing). */
+  private loadUnless(signal: AbortSignal): Promise<TalkingFaceEngine | null> {
+    const stopped = new Promise<null>((resolve) => (signal.aborted ? resolve(null) : signal.addEventListener('abort', () => resolve(null), { once: true })));
+    return Promise.race([this.load().catch((e: unknown) => (signal.aborted ? null : Promise.reject(e))), stopped]);
+  }
+
+  /** Release the engine (another load takes one anew). */
+  private letGo(): void {
+    this.hold?.release();
+    [this.hold, this.loading, this.engine] = [null, null, null];
   }
 
   /**
@@ -292,7 +295,7 @@ export class TalkingFaceElement extends HTMLElement {
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (!start) return;
     if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined); // reported by fail()
-    else if (autoplay && src && this.hasAttribute('autoplay')) void this.speak(src).catch(() => undefined); // reported by fail()
+    else if (autoplay && src && this.hasAttribute('autoplay') && !this.work) void this.speak(src).catch(() => undefined); // reported by fail()
   }
 
   /** A frame event for each frame shown while playing. */
@@ -315,15 +318,5 @@ export class TalkingFaceElement extends HTMLElement {
     this.setStatus(message, true);
     this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
     return new Error(message);
-  }
-}
-
-export function defineTalkingFace(name = 'talking-face'): void {
-  if (!customElements.get(name)) customElements.define(name, name === 'talking-face' ? TalkingFaceElement : class extends TalkingFaceElement {});
-}
-
-declare global {
-  interface HTMLElementTagNameMap {
-    'talking-face': TalkingFaceElement;
   }
 }

@@ -50,6 +50,11 @@ export class ContentEncoder {
     return new ContentEncoder(manifest, content, hierarchical);
   }
 
+  /** Free both sessions (TalkingFaceEngine.dispose). */
+  release(): Promise<void> {
+    return Promise.all([this.content.release(), this.hierarchical.release()]).then(() => undefined);
+  }
+
   /**
    * Mel frames of context before a range's first content frame: the encoder's look-back, rounded up to a
    * whole content frame so the strided convolution lines up with the whole clip.

@@ -11,9 +11,12 @@
  */
 import type * as Ort from 'onnxruntime-web';
 import { ModelLoadError } from '../model/artefacts';
-import { checkFeeds, type Feeds, type SessionSpec } from './onnx-spec';
+import { STALL_SECONDS } from '../model/fetch-body';
+import { checkFeeds, type ExecutionProvider, type Feeds, type SessionSpec } from './onnx-spec';
+import { markRequested, ortRoot, ortThreads, OrtWorker, sessionOptions, setRuntimeStallSeconds, WorkerRunner, type Outputs, type Runner } from './ort-worker-client';
+export { sessionsRequested } from './ort-worker-client';
 
-export type ExecutionProvider = 'webgpu' | 'wasm';
+export type { ExecutionProvider } from './onnx-spec';
 
 /** Tried in this order; the first that creates every session wins. */
 export const PROVIDER_PRIORITY: ExecutionProvider[] = ['webgpu', 'wasm'];
@@ -32,26 +35,6 @@ export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
 
 const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
 
-/**
- * Where onnxruntime's files are served: vite.config.ts copies them to ort/<version>/. In a build, ort/ is the sibling
- * of the folder holding this code (assets/ for the app, lib/ for the library), so an embedding page finds them
- * wherever it hosts the build; in dev, at the server root. The version in the path lets a browser keep them for good
- * (docs/embedding.md).
- */
-function ortRoot(): string {
-  const sibling = '../ort/'; // (a variable: Vite would turn a literal in new URL() into a glob of assets)
-  return import.meta.env.DEV
-    ? new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href
-    : new URL(sibling, import.meta.url).href;
-}
-
-/** onnxruntime's threads: up to 4 where the page is cross-origin isolated (SharedArrayBuffer) and has workers, else 1. */
-function ortThreads(): number {
-  const isolated = Boolean((globalThis as { crossOriginIsolated?: boolean }).crossOriginIsolated) && typeof Worker !== 'undefined';
-  const cores = (globalThis.navigator as Navigator | undefined)?.hardwareConcurrency ?? 1;
-  return isolated ? Math.max(1, Math.min(4, cores)) : 1;
-}
-
 /** onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker). */
 export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
   ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then((ort) => {
@@ -62,15 +45,6 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     return ort;
   });
   return ortModules[build];
-}
-
-type Outputs = Record<string, { data: Float32Array; dims: readonly number[] }>;
-
-/** A created session wherever it runs: in the page, or in onnxruntime's worker. */
-interface Runner {
-  readonly inputNames: readonly string[];
-  run(feeds: Feeds): Promise<Outputs>;
-  release(): Promise<void>;
 }
 
 /** A session in the page's thread. */
@@ -107,160 +81,19 @@ class PageRunner implements Runner {
 }
 
 /**
- * onnxruntime-web's plain WebAssembly build in a worker of its own (onnx-worker.ts): creating the encoders' sessions
- * (about half a second of graph work on a busy CPU) and every run leave the page's main thread to the face, which
- * is built and drawn meanwhile (issue 18, first load). Each request is one message: nothing waits on a reply from
- * the page's thread but the result itself. One worker per page, started with the engine's load.
- */
-/** How long onnxruntime's worker may take to answer its first message before the sessions go to the page instead. */
-const WORKER_START_MS = 15_000;
-
-class OrtWorker {
-  private static shared: OrtWorker | null = null;
-  /** Resolves when the worker has answered its first message; rejects if it could not start. */
-  readonly started: Promise<void>;
-  private readonly pending = new Map<number, { resolve: (m: Record<string, unknown>) => void; reject: (e: Error) => void }>();
-  private nextId = 0;
-  private failure: Error | null = null;
-
-  private constructor(private readonly worker: Worker) {
-    let onStarted: () => void = () => undefined;
-    this.started = new Promise<void>((resolve, reject) => {
-      const timer = setTimeout(() => {
-        this.fail(new Error(`onnxruntime's worker did not start within ${WORKER_START_MS / 1000} s`));
-        reject(this.failure);
-      }, WORKER_START_MS);
-      onStarted = () => {
-        clearTimeout(timer);
-        resolve();
-      };
-      worker.onerror = (e) => {
-        e.preventDefault();
-        clearTimeout(timer);
-        this.fail(new Error(e.message || "onnxruntime's worker could not start"));
-        reject(this.failure);
-      };
-    });
-    // Deliberate: the outcome is read where a session is asked for (OnnxModel.runner); a worker that fails before
-    // then must not be an unhandled rejection.
-    this.started.catch(() => undefined); // read where a session is asked for
-    worker.onmessage = (e: MessageEvent<{ type?: string; id?: number; error?: string }>) => {
-      const m = e.data;
-      if (m.type === 'started') return onStarted();
-      const p = this.pending.get(m.id!);
-      if (!p) return;
-      this.pending.delete(m.id!);
-      if (m.error !== undefined) p.reject(new Error(m.error));
-      else p.resolve(m as Record<string, unknown>);
-    };
-    worker.postMessage({ type: 'init', ortRoot: ortRoot(), numThreads: ortThreads() });
-  }
-
-  /** The page's worker, started on the first call; null where the page cannot start one (then sessions run in the page). */
-  static get(): OrtWorker | null {
-    if (typeof Worker === 'undefined') return null;
-    if (!OrtWorker.shared) {
-      try {
-        OrtWorker.shared = new OrtWorker(new Worker(new URL('./onnx-worker.ts', import.meta.url), { type: 'module', name: 'onnxruntime' }));
-      } catch (e) {
-        console.warn(`onnxruntime's worker could not be created (${(e as Error).message}); the encoders run in the page`);
-        return null;
-      }
-    }
-    return OrtWorker.shared.failure ? null : OrtWorker.shared;
-  }
-
-  call(message: Record<string, unknown>, transfer: Transferable[] = []): Promise<Record<string, unknown>> {
-    if (this.failure) return Promise.reject(this.failure);
-    const id = this.nextId++;
-    return new Promise((resolve, reject) => {
-      this.pending.set(id, { resolve, reject });
-      this.worker.postMessage({ ...message, id }, transfer);
-    });
-  }
-
-  private fail(e: Error): void {
-    this.failure = e;
-    for (const p of this.pending.values()) p.reject(e);
-    this.pending.clear();
-    this.worker.terminate();
-  }
-
-  get failed(): boolean {
-    return this.failure !== null;
-  }
-
-  /**
-   * Give up on `w`, whose onnxruntime could not load its runtime (onnxruntime remembers a failed set-up for the
-   * worker's life): the next session asked for starts a new worker, which fetches the runtime again.
-   */
-  static discard(w: OrtWorker, why: Error): void {
-    if (OrtWorker.shared === w) OrtWorker.shared = null;
-    w.fail(why);
-  }
-}
-
-/** A session in onnxruntime's worker. */
-class WorkerRunner implements Runner {
-  private constructor(private readonly worker: OrtWorker, private readonly id: number, readonly inputNames: readonly string[]) {}
-
-  static async create(worker: OrtWorker, spec: SessionSpec, provider: ExecutionProvider): Promise<WorkerRunner> {
-    // A copy travels: the caller's bytes stay usable (a failed worker falls back to the page with them).
-    const creating = worker.call({ type: 'create', bytes: spec.bytes.slice(0), options: sessionOptions(provider) });
-    markRequested();
-    const reply = (await creating) as { id: number; inputNames: string[] };
-    return new WorkerRunner(worker, reply.id, reply.inputNames);
-  }
-
-  async run(feeds: Feeds): Promise<Outputs> {
-    const sent: Record<string, { type: string; data: Float32Array | BigInt64Array; dims: number[] }> = {};
-    for (const [name, f] of Object.entries(feeds)) sent[name] = { type: f.data instanceof BigInt64Array ? 'int64' : 'float32', data: f.data, dims: f.shape };
-    return ((await this.worker.call({ type: 'run', session: this.id, feeds: sent })) as { outputs: Outputs }).outputs;
-  }
-
-  async release(): Promise<void> {
-    await this.worker.call({ type: 'release', session: this.id });
-  }
-}
-
-let requested = 0;
-const requestWaiters: { count: number; resolve: () => void }[] = [];
-
-/** Count one session asked of onnxruntime (sessionsRequested). */
-function markRequested(): void {
-  requested++;
-  for (const w of requestWaiters.filter((x) => x.count <= requested)) {
-    requestWaiters.splice(requestWaiters.indexOf(w), 1);
-    w.resolve();
-  }
-}
-
-/**
- * Resolves once `count` sessions have been asked of onnxruntime (and its worker, where it has one, has started):
- * they are then being created off the page's main thread, which a page with heavy work of its own (building and
- * drawing the face) can start on without holding them up (src/app/main.ts).
- */
-export function sessionsRequested(count: number): Promise<void> {
-  if (requested >= count) return Promise.resolve();
-  return new Promise((resolve) => requestWaiters.push({ count, resolve }));
-}
-
-/**
  * Start loading onnxruntime for `providers` now, before any model file has arrived: its worker (the wasm provider), or
  * its script in the page (the WebGPU provider, or where no worker can run).
  */
-export function startOrt(providers: readonly ExecutionProvider[]): void {
+export function startOrt(providers: readonly ExecutionProvider[], stallSeconds = STALL_SECONDS): void {
+  setRuntimeStallSeconds(stallSeconds);
   const build = ortBuildFor(providers);
   if (build === 'jsep' || !OrtWorker.get()) void loadOrt(build).catch(() => undefined); // (its error is met again at session creation)
-}
-
-function sessionOptions(provider: ExecutionProvider): Ort.InferenceSession.SessionOptions {
-  return { executionProviders: [provider], graphOptimizationLevel: 'all', logSeverityLevel: 3 };
 }
 
 /** A session plus a queue: `run` calls are executed one after another. */
 export class OnnxModel {
   private queue: Promise<unknown> = Promise.resolve();
+  private released: Promise<void> | null = null;
 
   private constructor(
     readonly name: string,
@@ -313,6 +146,7 @@ export class OnnxModel {
 
   /** Run with float32 / int64 feeds given as (data, shape); shapes are checked against the manifest first. */
   run(feeds: Feeds): Promise<Record<string, { data: Float32Array; dims: readonly number[] }>> {
+    if (this.released) return Promise.reject(new Error(`${this.name}: the session was released (the engine was disposed)`));
     checkFeeds(this.name, this.inputs, feeds);
     const job = this.queue.then(() => this.runner.run(feeds));
     // One failed run must not stop the next.
@@ -320,7 +154,9 @@ export class OnnxModel {
     return job;
   }
 
+  /** Free the session (after the runs already asked for); a run asked for later is refused. Once is enough. */
   release(): Promise<void> {
-    return this.runner.release();
+    this.released ??= this.queue.then(() => this.runner.release());
+    return this.released;
   }
 }

@@ -5,6 +5,9 @@
  */
 import type { Manifest } from '../model/manifest';
 
+/** Where an ONNX session runs (onnxruntime-web's execution providers this project uses). */
+export type ExecutionProvider = 'webgpu' | 'wasm';
+
 export interface SessionSpec {
   name: string;
   bytes: ArrayBuffer;

@@ -3,26 +3,32 @@
  * run here, off the page's main thread, which meanwhile builds and draws the face (issue 18, first load). Jobs run
  * one after another, as onnxruntime-web needs. Every message the page sends is answered with its id.
  *
- *   page -> worker  { type: 'init', ortRoot, numThreads }                 -> { type: 'started' }   (first, once)
+ *   page -> worker  { type: 'init', ortRoot, numThreads, stallSeconds }   -> { type: 'started' }   (first, once)
  *                   { type: 'create', id, bytes, options }               -> { id, inputNames }
  *                   { type: 'run', id, session, feeds }                  -> { id, outputs }       (data transferred back)
  *                   { type: 'release', id, session }                     -> { id }
  *   worker -> page  { id, error } where a job failed.
  */
 import * as ort from 'onnxruntime-web/wasm';
+import { fetchBody } from '../model/fetch-body';
 
 type Feed = { type: 'float32' | 'int64'; data: Float32Array | BigInt64Array; dims: number[] };
 type Message =
-  | { type: 'init'; ortRoot: string; numThreads: number }
+  | { type: 'init'; ortRoot: string; numThreads: number; stallSeconds: number }
   | { type: 'create'; id: number; bytes: ArrayBuffer; options: ort.InferenceSession.SessionOptions }
   | { type: 'run'; id: number; session: number; feeds: Record<string, Feed> }
   | { type: 'release'; id: number; session: number };
 
 const sessions = new Map<number, ort.InferenceSession>();
 let queue: Promise<unknown> = Promise.resolve();
+/** The plain WebAssembly build's runtime (vite.config.ts copies it under the page's ort/ folder). */
+const RUNTIME_FILE = 'ort-wasm-simd-threaded.wasm';
+/** Its download, started by 'init': sessions are created once it is in. */
+let runtime: Promise<void> = Promise.resolve();
 
 async function handle(m: Exclude<Message, { type: 'init' }>): Promise<{ reply: Record<string, unknown>; transfer: Transferable[] }> {
   if (m.type === 'create') {
+    await runtime;
     const session = await ort.InferenceSession.create(new Uint8Array(m.bytes), m.options);
     sessions.set(m.id, session);
     return { reply: { id: m.id, inputNames: session.inputNames }, transfer: [] };
@@ -48,9 +54,21 @@ self.onmessage = (e: MessageEvent<Message>) => {
   const m = e.data;
   if (m.type === 'init') {
     // ortRoot: the page's ort/ folder (onnx-model.ts); the runtime's files are under its version there.
-    ort.env.wasm.wasmPaths = `${m.ortRoot}${ort.env.versions.web}/`;
+    const root = `${m.ortRoot}${ort.env.versions.web}/`;
+    ort.env.wasm.wasmPaths = root;
     ort.env.wasm.numThreads = m.numThreads;
     ort.env.logLevel = 'error';
+    // The runtime's WebAssembly is fetched here, not by onnxruntime: its loader falls back to a synchronous request
+    // when its fetch fails, which waits forever on a stalled connection. fetchBody fails after stallSeconds instead,
+    // and the sessions' creation then fails naming the runtime (onnx-model.ts reads "no available backend").
+    const url = `${root}${RUNTIME_FILE}`;
+    runtime = fetchBody(url, { stallSeconds: m.stallSeconds }).then((r) => {
+      if (!r.ok) throw new Error(`HTTP ${r.status}`);
+      ort.env.wasm.wasmBinary = new Uint8Array(r.bytes);
+    }).catch((e: Error) => {
+      throw new Error(`no available backend: ${url} could not be downloaded (${e.message})`);
+    });
+    runtime.catch(() => undefined); // deliberate: read by the first session's creation
     // The reply proves that the page's messages reach this worker (until the page's thread has had a turn after
     // the worker started, they may wait there): the page sends its sessions after it.
     self.postMessage({ type: 'started' });

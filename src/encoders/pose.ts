@@ -33,6 +33,11 @@ export class PoseEncoder {
     return new PoseEncoder(manifest, conv, lstm);
   }
 
+  /** Free both sessions (TalkingFaceEngine.dispose). */
+  release(): Promise<void> {
+    return Promise.all([this.conv.release(), this.lstm.release()]).then(() => undefined);
+  }
+
   newState(): PoseState {
     const C = this.manifest.model.config.pose_channels;
     return { h: new Float32Array(C), c: new Float32Array(C), lstmDone: 0, poseFeatures: new Float32Array(0), poseFeaturesStart: 0 };

@@ -26,6 +26,7 @@ export class DecoderBackends {
   /** Why the backend is what it is, for the status line. */
   reason: string;
   private pool: DecoderPool | null = null;
+  private disposed = false;
 
   private constructor(
     readonly cpu: FastDecoder,
@@ -93,6 +94,7 @@ export class DecoderBackends {
 
   /** Offsets and poses of `frames` frames from their hierarchical latents (F x 2d) and pose tokens. */
   async decode(latents: Float32Array, poseToken: Float32Array, frames: number, vertices: number): Promise<DecodeResult> {
+    if (this.disposed) throw new EngineDisposedError();
     const gpu = this.gpu;
     if (gpu) {
       try {
@@ -109,10 +111,12 @@ export class DecoderBackends {
         }
       }
     }
+    if (this.disposed) throw new EngineDisposedError(); // its WebGPU buffers destroyed under the decode above
     if (this.pool && frames > 1) {
       try {
         return await this.pool.decode(latents, poseToken, frames);
       } catch (e) {
+        if (this.disposed) throw new EngineDisposedError(); // terminated by dispose(), not crashed
         // A crashed worker: decode in this thread from now on (same numbers), and say so.
         this.pool.terminate();
         this.pool = null;
@@ -163,5 +167,22 @@ export class DecoderBackends {
     this.gpu = decoder;
     this.backend = 'webgpu';
     this.reason = `WebGPU: ${support.description}`;
+  }
+
+  /** Free the WebGPU decoder's buffers and the CPU decoder's workers; later decodes are refused. */
+  dispose(): void {
+    this.disposed = true;
+    this.gpu?.destroy();
+    this.gpu = null;
+    this.pool?.terminate();
+    this.pool = null;
+  }
+}
+
+/** What a disposed engine's calls reject with (TalkingFaceEngine.dispose). */
+export class EngineDisposedError extends Error {
+  constructor() {
+    super('this talking-face engine was disposed; load a new one');
+    this.name = 'EngineDisposedError';
   }
 }

@@ -10,7 +10,7 @@ import { frameToMelIndex, type Manifest } from '../model/manifest';
 import { logMelFrames, melFrameCount } from '../audio/mel';
 import type { ContentEncoder } from '../encoders/content';
 import type { PoseEncoder, PoseState } from '../encoders/pose';
-import type { DecoderBackends } from './backends';
+import { EngineDisposedError, type DecoderBackends } from './backends';
 import { poseFrames } from '../pose/posing';
 import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
 import { levelAt } from '../encoders/voice-activity';
@@ -49,6 +49,7 @@ export class Pipeline {
   private restWeights: Promise<Float32Array> | null = null;
   private rest: Promise<Float32Array> | null = null;
   private closure: LipClosure | null | undefined;
+  private disposed = false;
 
   constructor(
     readonly manifest: Manifest,
@@ -96,6 +97,14 @@ export class Pipeline {
     if (options.blendshapes) state.blendshapes = this.avatarWeights.newState();
     state.headScale = options.headMotionScale ?? this.headScale;
     return state;
+  }
+
+  /** Free the encoders' sessions and the decoders (TalkingFaceEngine.dispose); later runs are refused. */
+  async dispose(): Promise<void> {
+    if (this.disposed) return;
+    this.disposed = true;
+    this.decoders.dispose();
+    await Promise.all([this.content.release(), this.pose.release()]);
   }
 
   /** The model's closure on the face's own lip gap (null: a model exported without it), built on first use. */
@@ -180,6 +189,7 @@ export class Pipeline {
    */
   async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number,
     inputs?: { tokens?: Float32Array; poseToken?: Float32Array }): Promise<Frames> {
+    if (this.disposed) throw new EngineDisposedError();
     const a = this.manifest.audio;
     const K = Number.isFinite(total) ? melFrameCount(total, a) : Infinity;
     const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));

@@ -262,6 +262,7 @@ export class FaceView {
     this.model.dispose();
     this.environment.dispose();
     this.renderer.dispose();
+    this.renderer.forceContextLoss(); // now, not at garbage collection: a page keeps 16 WebGL contexts at most
   }
 
   /** shown = rest + s (frame - rest) + (1 - s) b B, then everything that follows the face. */

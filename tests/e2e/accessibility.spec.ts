@@ -155,3 +155,26 @@ test('<talking-face>: the face turns and zooms by keyboard; screen readers hear 
   // The page's own live regions (the element's are in its shadow root, watched above): the frame counters are not.
   expect(spoke.filter((k) => k !== 'log'), 'no live region of the page but its event log').toEqual([]);
 });
+
+test('<talking-face>: focus stays on the face when it is shown after loading; the page names each face', async ({ page }) => {
+  test.setTimeout(90_000);
+  await page.goto('/examples/embed.html', { waitUntil: 'domcontentloaded' });
+  await page.evaluate(() => customElements.whenDefined('talking-face'));
+  const status = () => page.evaluate(() => document.getElementById('left')!.shadowRoot!.querySelector('.status')!.textContent);
+  expect(await status()).toContain('Loading');
+  await page.locator('#left canvas').focus();
+  await expect.poll(status, { timeout: 60_000 }).toContain('Ready');
+  const focused = () => page.evaluate(() => {
+    const host = document.activeElement as HTMLElement | null;
+    return `${host?.id}/${host?.shadowRoot?.activeElement?.tagName ?? ''}`;
+  });
+  expect(await focused(), 'the new canvas took the focus of the one it replaced').toBe('left/CANVAS');
+  const before = await page.locator('#left canvas').getAttribute('aria-label');
+  expect(before).toMatch(/^Left face\. .*Arrow keys orbit/);
+  expect(await page.locator('#right canvas').getAttribute('aria-label')).toMatch(/^Right face\. /);
+  // The element is a group (its ElementInternals' default role), named by the page: as Chromium's tree has it
+  // (Playwright's own snapshot computes roles from the DOM alone and does not see an element's internals).
+  const cdp = await page.context().newCDPSession(page);
+  const { nodes } = (await cdp.send('Accessibility.getFullAXTree')) as { nodes: { role?: { value: string }; name?: { value: string } }[] };
+  expect(nodes.filter((n) => n.name?.value === 'Left face').map((n) => n.role?.value)).toEqual(['group']);
+});

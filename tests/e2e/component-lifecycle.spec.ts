@@ -5,7 +5,8 @@ import { fakeMicrophone } from '../../playwright.config';
 /**
  * <talking-face> told to stop, removed, moved or switched while it works (examples/embed.html): it never opens the
  * microphone or plays after a stop or once removed, stop() cancels an animation under way, one element's backend
- * leaves the others' alone, and a moved element draws again without WebGL errors.
+ * leaves the others' alone, a moved element goes on as it was, and removed elements give back their WebGL context and
+ * (after a while) their engine.
  */
 test.use({ launchOptions: fakeMicrophone(resolve(import.meta.dirname, '../fixtures/speech-kal.wav')) });
 
@@ -116,7 +117,7 @@ test('one element\'s backend attribute leaves the others\' engines alone; a bad 
   await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(5);
 });
 
-test('an element moved in the page draws again, without WebGL errors', async ({ page }) => {
+test('an element moved in the page (removed and put back at once) goes on: no new load, playback not cut, no WebGL errors', async ({ page }) => {
   test.setTimeout(120_000);
   await page.addInitScript(WATCH);
   const gl: string[] = [];
@@ -125,12 +126,92 @@ test('an element moved in the page draws again, without WebGL errors', async ({ 
   const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
   await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(1);
   await page.evaluate(() => document.body.append(document.getElementById('left')!));
-  await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(2);
   await page.locator('#speak').click();
-  // Played to its end (frames come at the page's frame rate: a few a second on a loaded machine with software WebGL).
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'frame:playback').length ?? 0, { timeout: 60_000 }).toBeGreaterThan(0);
+  // Moved while it plays: it plays on to its end (frames come at the page's frame rate: a few a second on a loaded machine with software WebGL).
+  await page.evaluate(() => document.querySelector('.pair')!.prepend(document.getElementById('left')!));
   await expect.poll(async () => (await events()).left?.filter((e) => e === 'ended').length ?? 0, { timeout: 60_000 }).toBe(1);
   expect((await events()).left?.filter((e) => e === 'frame:playback').length).toBeGreaterThan(2);
+  expect((await events()).left?.filter((e) => e.startsWith('ready')), 'moved twice, loaded once').toHaveLength(1);
+  expect(await page.evaluate(statusOf('left'))).toMatch(/^Played \(\d+ frames, /);
   const stats = await imageStats(page, await page.locator('#left').screenshot());
   expect(stats.foregroundFraction, 'the moved face is drawn').toBeGreaterThan(0.1);
   expect(gl, 'WebGL messages').toEqual([]);
+});
+
+test('removed from the page, the elements free their engine (onnxruntime\'s worker, the decoder workers); put back, they load again', async ({ page }) => {
+  test.setTimeout(150_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  const readies = async (id: string) => (await events())[id]?.filter((e) => e.startsWith('ready')).length ?? 0;
+  await expect.poll(async () => (await readies('left')) + (await readies('right')), { timeout: 60_000 }).toBe(2);
+  const names = () => page.workers().map((w) => w.url().replace(/^.*\/assets\//, ''));
+  const working = names().length;
+  expect(working, `the engine's workers: ${names().join(', ')}`).toBeGreaterThanOrEqual(2);
+  // Moved (removed and put back at once): the same engine, nothing loaded again.
+  await page.evaluate(() => document.body.append(document.getElementById('right')!));
+  await page.waitForTimeout(1_000);
+  expect(await readies('right')).toBe(1);
+  expect(names().length).toBe(working);
+  // Both removed: after the engine's linger (ENGINE_LINGER_MS, 10 s) every worker it started has ended.
+  await page.evaluate(() => {
+    const g = globalThis as unknown as { parked: HTMLElement[] };
+    g.parked = ['left', 'right'].map((id) => document.getElementById(id)!);
+    for (const el of g.parked) el.remove();
+  });
+  await page.waitForTimeout(5_000);
+  expect(names().length, 'kept a while (an element put back soon takes it back)').toBe(working);
+  await expect.poll(() => names().length, { timeout: 30_000, message: `workers left: ${names().join(', ')}` }).toBe(0);
+  // Put back: loads again, and speaks.
+  await page.evaluate(() => document.querySelector('.pair')!.append(...(globalThis as unknown as { parked: HTMLElement[] }).parked));
+  await expect.poll(async () => (await readies('left')) + (await readies('right')), { timeout: 60_000 }).toBe(4);
+  await page.locator('#speak').click();
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'ended').length ?? 0, { timeout: 60_000 }).toBe(1);
+  expect((await events()).left).not.toContain('error');
+});
+
+test('removed elements give their WebGL context back at once: 18 shown and removed, held by the page, none evicted', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.addInitScript(WATCH);
+  const warnings: string[] = [];
+  page.on('console', (m) => /Too many active WebGL contexts/.test(m.text()) && warnings.push(m.text()));
+  await page.goto('/examples/embed.html');
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(1);
+  for (let i = 0; i < 18; i++) {
+    // Kept by the page (a route cache, a framework's reference) after it is removed: only dispose frees its context.
+    await page.evaluate((id) => {
+      const g = globalThis as unknown as { kept?: HTMLElement[] };
+      const el = document.createElement('talking-face');
+      el.id = id;
+      el.setAttribute('backend', 'cpu');
+      (g.kept ??= []).push(el);
+      document.body.append(el);
+    }, `kept${i}`);
+    await expect.poll(async () => (await events())[`kept${i}`]?.filter((e) => e.startsWith('ready')).length ?? 0, { timeout: 30_000 }).toBe(1);
+    await page.evaluate((id) => document.getElementById(id)!.remove(), `kept${i}`);
+  }
+  await page.waitForTimeout(1_000);
+  expect(warnings, 'contexts evicted').toEqual([]);
+  const seen = await events();
+  expect(Object.entries(seen).filter(([, e]) => e.some((x) => x === 'error')), 'error events').toEqual([]);
+  // The elements on the page still draw.
+  expect((await imageStats(page, await page.locator('#left').screenshot())).foregroundFraction).toBeGreaterThan(0.1);
+});
+
+test('src set while the model loads is spoken once it is in; a clip played to its end says so', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html', { waitUntil: 'domcontentloaded' });
+  await page.evaluate(() => customElements.whenDefined('talking-face'));
+  expect(await page.evaluate(statusOf('left'))).toContain('Loading');
+  await page.evaluate(() => document.getElementById('left')!.setAttribute('src', '/examples/sample.wav'));
+  const events = () => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents);
+  await expect.poll(async () => (await events()).left?.filter((e) => e === 'ended').length ?? 0, { timeout: 90_000 }).toBe(1);
+  const seen = (await events()).left!;
+  expect(seen.filter((e) => e.startsWith('ready'))).toHaveLength(1);
+  expect(seen).toContain('frame:playback');
+  expect(seen).not.toContain('error');
+  expect(await page.evaluate(statusOf('left'))).toMatch(/^Played \(\d+ frames, /);
 });

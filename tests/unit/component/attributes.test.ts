@@ -38,4 +38,11 @@ describe('<talking-face> attributes', () => {
     const blob = new Blob(['x']);
     expect(await audioInput(blob)).toBe(blob);
   });
+
+  it('anything else is refused with a message that says what speak() takes and what it got', async () => {
+    const takes = 'speak() takes a Blob or File, an AudioBuffer, or a URL';
+    for (const [input, got] of [[42, 'number'], [undefined, 'undefined'], [null, 'null'], ['', 'an empty string'], [{}, 'Object'], [new Float32Array(4), 'Float32Array']] as const) {
+      await expect(audioInput(input as never)).rejects.toThrow(`${takes} (got ${got})`);
+    }
+  });
 });

@@ -1,31 +1,72 @@
-/** The engines <talking-face> elements share (src/component/engines.ts): one load per model, template and backend. */
+/**
+ * The engines <talking-face> elements share (src/component/engines.ts): one load per model, template and backend,
+ * disposed ENGINE_LINGER_MS after the last element holding it lets go, unless one takes it back meanwhile.
+ */
 import { afterEach, describe, expect, it, vi } from 'vitest';
 import { TalkingFaceEngine } from '../../../src/engine/engine';
-import { sharedEngine } from '../../../src/component/engines';
+import { ENGINE_LINGER_MS, holdEngine } from '../../../src/component/engines';
 
-afterEach(() => vi.restoreAllMocks());
+afterEach(() => {
+  vi.restoreAllMocks();
+  vi.useRealTimers();
+});
 
-describe('sharedEngine', () => {
+const fakeEngine = () => ({ dispose: vi.fn(async () => undefined) }) as unknown as TalkingFaceEngine & { dispose: ReturnType<typeof vi.fn> };
+
+describe('holdEngine', () => {
   it('loads once per model, template and backend, and passes each what the element asked for', async () => {
-    const fake = {} as TalkingFaceEngine;
+    const fake = fakeEngine();
     const load = vi.spyOn(TalkingFaceEngine, 'load').mockResolvedValue(fake);
-    const a = sharedEngine('/models/manifest.json', null, 'auto');
-    const b = sharedEngine('/models/manifest.json', null, 'auto');
-    const c = sharedEngine('/models/manifest.json', null, 'cpu');
-    const d = sharedEngine('/models/manifest.json', '/other/template.json', 'auto');
-    expect(a).toBe(b);
-    expect(c).not.toBe(a);
-    expect(d).not.toBe(a);
+    const a = holdEngine('/models/manifest.json', null, 'auto');
+    const b = holdEngine('/models/manifest.json', null, 'auto');
+    const c = holdEngine('/models/manifest.json', null, 'cpu');
+    const d = holdEngine('/models/manifest.json', '/other/template.json', 'auto');
+    expect(a.engine).toBe(b.engine);
+    expect(c.engine).not.toBe(a.engine);
+    expect(d.engine).not.toBe(a.engine);
     expect(load).toHaveBeenCalledTimes(3);
     expect(load.mock.calls.map(([o]) => [o!.templateUrl, o!.backend])).toEqual([[undefined, 'auto'], [undefined, 'cpu'], ['/other/template.json', 'auto']]);
-    expect(await a).toBe(fake);
+    expect(await a.engine).toBe(fake);
+    for (const h of [a, b, c, d]) h.release();
   });
 
   it('forgets a failed load, so a later element tries again', async () => {
-    const load = vi.spyOn(TalkingFaceEngine, 'load').mockRejectedValueOnce(new Error('offline')).mockResolvedValue({} as TalkingFaceEngine);
-    await expect(sharedEngine('/failing/manifest.json', null, 'auto')).rejects.toThrow('offline');
+    const load = vi.spyOn(TalkingFaceEngine, 'load').mockRejectedValueOnce(new Error('offline')).mockResolvedValue(fakeEngine());
+    const failed = holdEngine('/failing/manifest.json', null, 'auto');
+    await expect(failed.engine).rejects.toThrow('offline');
+    failed.release();
     await Promise.resolve();
-    await expect(sharedEngine('/failing/manifest.json', null, 'auto')).resolves.toBeDefined();
+    const again = holdEngine('/failing/manifest.json', null, 'auto');
+    await expect(again.engine).resolves.toBeDefined();
     expect(load).toHaveBeenCalledTimes(2);
+    again.release();
+  });
+
+  it('disposes an engine once the last hold is released and the linger has passed; a hold taken back in time keeps it', async () => {
+    vi.useFakeTimers();
+    const first = fakeEngine();
+    const second = fakeEngine();
+    const load = vi.spyOn(TalkingFaceEngine, 'load').mockResolvedValueOnce(first).mockResolvedValueOnce(second);
+    const a = holdEngine('/linger/manifest.json', null, 'auto');
+    const b = holdEngine('/linger/manifest.json', null, 'auto');
+    await a.engine;
+    a.release();
+    a.release(); // once is enough: b still holds it
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS * 2);
+    expect(first.dispose).not.toHaveBeenCalled();
+    b.release();
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS / 2);
+    const moved = holdEngine('/linger/manifest.json', null, 'auto'); // an element put back within the linger
+    expect(await moved.engine).toBe(first);
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS * 2);
+    expect(first.dispose).not.toHaveBeenCalled();
+    moved.release();
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS + 1);
+    expect(first.dispose).toHaveBeenCalledTimes(1);
+    // Gone: the next element loads anew.
+    const later = holdEngine('/linger/manifest.json', null, 'auto');
+    expect(await later.engine).toBe(second);
+    expect(load).toHaveBeenCalledTimes(2);
+    later.release();
   });
 });
