@@ -1,11 +1,12 @@
 /**
- * Export an animation as binary glTF (.glb) that standard viewers play: the whole head (render/head.ts: face,
+ * Export an animation as binary glTF (.glb) that standard viewers play, life-size (in metres): the whole head (render/head.ts: face,
  * skull and neck, eyes, teeth, tongue, the mouth's inside), with the head pose as the head node's rotation and
  * translation, the lower jaw's rotation (estimated from the face, render/jaw.ts), the tongue's raise and the eyes'
  * gaze as tracks, and the motion of the face (with the shell and mouth that follow it) as morph targets, in one of
  * two encodings:
- * - up to GLB_EXACT_FRAMES frames, exact: the neutral face as the mesh, one morph target per frame
- *   (that frame's I + O minus I) and a weights track that steps through them (one target on at a time);
+ * - up to GLB_EXACT_FRAMES frames (10 s), exact: the neutral face as the mesh, one morph target per frame
+ *   (that frame's I + O minus I) and a weights track that steps through them (one target on at a time); a viewer
+ *   declares a uniform per target (three.js), and many GPUs allow about a thousand, so longer clips are not sent so;
  * - longer clips, compact: the mean face as the mesh and GLB_COMPONENTS morph targets, the strongest
  *   directions of the clip's motion (motion-basis.ts), with every frame's weights; the largest
  *   deviation from the exact frames is measured and reported. Eight is the number of simultaneous
@@ -22,7 +23,7 @@ import { Head } from '../render/head';
 import { IdleMotion } from '../render/idle-motion';
 
 /** Longest clip exported with one morph target per frame (its weights track is frames x frames). */
-export const GLB_EXACT_FRAMES = 1800;
+export const GLB_EXACT_FRAMES = 300;
 /** Morph targets in the compact encoding of longer clips. */
 export const GLB_COMPONENTS = 8;
 /** Share of a long clip's export spent posing the head frame by frame (the rest finds its components; measured). */
@@ -88,8 +89,14 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   geometry.computeVertexNormals();
   head.skin.updateMorphTargets();
   head.group.name = name;
+  // glTF's unit is the metre: the head (in the template's units, centimetres for the MediaPipe face) under a root
+  // that scales it, so that other tools show it life-size (its pose and motion stay in the head's own units inside).
+  const root = new THREE.Group();
+  root.name = `${name}_root`;
+  root.scale.setScalar(1 / (unitsPerMm * 1000));
+  root.add(head.group, head.body);
   const scene = new THREE.Scene();
-  scene.add(head.group, head.body);
+  scene.add(root);
 
   const times = Float32Array.from({ length: frames }, (_, f) => f / animation.fps);
   const quats = new Float32Array(frames * 4);
@@ -139,7 +146,7 @@ function gazeTracks(head: Head, times: Float32Array): THREE.KeyframeTrack[] {
  * Re-load a .glb with three.js: the face mesh's morph targets and vertices, the animation clips, their duration,
  * the names of the head's parts, and which of them the clip animates.
  */
-export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[] }> {
+export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[]; heightM: number }> {
   const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
   const gltf = await new GLTFLoader().parseAsync(bytes, '');
   let face: THREE.Mesh | null = null;
@@ -155,6 +162,8 @@ export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: nu
     duration: gltf.animations[0]?.duration ?? 0,
     vertices: m?.geometry.getAttribute('position').count ?? 0,
     parts,
+    /** The scene's height in glTF's unit, the metre (the head and shoulders). */
+    heightM: new THREE.Box3().setFromObject(gltf.scene).getSize(new THREE.Vector3()).y,
     // The face's two primitives (skin, mouth) load as child meshes of the 'face' node, each with its morph track.
     animated: [...new Set((gltf.animations[0]?.tracks ?? []).map((t) => {
       const node = gltf.scene.getObjectByName(t.name.split('.')[0]);

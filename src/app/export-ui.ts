@@ -25,7 +25,7 @@ export async function exportGlbFile(animation: Animation, name: string, template
       signal: controller.signal,
       onProgress: (done) => showStatus(`${preparing}: ${Math.round(100 * done)}%… (Escape cancels)`),
     });
-    const file = `${name.replace(/\.[^.]+$/, '')}.glb`;
+    const file = `${baseName(name)}.glb`;
     download(new Blob([glb.bytes], { type: 'model/gltf-binary' }), file);
     tell(`Saved ${file}: the animation as a glTF model.`);
     ui.exportInfo.textContent = (`Exported ${glb.frames} frames as .glb (${(glb.bytes.byteLength / 1e6).toFixed(1)} MB)` +
@@ -44,8 +44,13 @@ export async function exportGlbFile(animation: Animation, name: string, template
 
 export function exportRawFile(animation: Animation, name: string, template: FaceTemplate): void {
   const n = template.vertexCount;
-  const file = `${name.replace(/\.[^.]+$/, '')}.${animation.frames}x${n}x3.f32`;
+  const file = `${baseName(name)}.${animation.frames}x${n}x3.f32`;
   download(rawFrames(animation), file);
   tell(`Saved ${file}: the raw frames.`);
   ui.exportInfo.textContent = (`Exported ${animation.frames} frames x ${n} vertices x 3 as float32 (little-endian, ${template.units}, ${animation.fps} fps).`);
+}
+
+/** A take's name without its extension, for the files it is saved as ('take' where nothing is left: a file named ".wav"). */
+function baseName(name: string): string {
+  return name.replace(/\.[^.]+$/, '').trim() || 'take';
 }
