@@ -71,6 +71,8 @@ export class AvatarView {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.target.copy(sphere.center);
     this.controls.enableDamping = true;
+    // Orbit and zoom only, and not into the head nor until it is a speck (a pinch on a phone has no other way back).
+    [this.controls.enablePan, this.controls.minDistance, this.controls.maxDistance] = [false, 1.5 * sphere.radius, 10 * sphere.radius];
     this.controls.addEventListener('change', () => this.requestRender());
     this.controls.update();
 

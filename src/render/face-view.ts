@@ -109,6 +109,8 @@ export class FaceView {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.target.copy(target);
     this.controls.enableDamping = true;
+    // Orbit and zoom only, and not into the head nor until it is a speck (a pinch on a phone has no other way back).
+    [this.controls.enablePan, this.controls.minDistance, this.controls.maxDistance] = [false, 1.2 * H, 8 * H];
     this.controls.addEventListener('change', () => this.requestRender());
     this.controls.update();
 
@@ -310,7 +312,7 @@ export class FaceView {
     const tan = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2));
     const distance = Math.max(this.frameSize.height / (2 * tan), this.frameSize.width / (2 * tan * this.camera.aspect));
     const t = this.controls.target;
-    this.camera.position.sub(t).setLength(distance).add(t);
+    this.camera.position.sub(t).setLength(THREE.MathUtils.clamp(distance, this.controls.minDistance, this.controls.maxDistance)).add(t);
     this.controls.update();
     this.requestRender();
   }

@@ -23,6 +23,25 @@ test.describe('the face viewer', () => {
     await test.info().attach('viewer.png', { body: shot, contentType: 'image/png' });
   });
 
+  test('zoom stops before the camera enters the head and before the head is a speck (a pinch has no other way back)', async ({ page }) => {
+    const canvas = page.locator('#face-canvas');
+    const shown = async () => (await imageStats(page, await canvas.screenshot({ style: '.view figcaption { visibility: hidden; }' }))).foregroundFraction;
+    // The camera's distance from what it looks at, in face heights (chin to forehead, about 20 cm).
+    const distance = () => page.evaluate(() => {
+      const v = (globalThis as unknown as { talkingFace: { view: { camera: { position: { distanceTo(t: unknown): number } }; controls: { target: unknown }; model: { measures: { top: number; chin: number } } } } }).talkingFace.view;
+      return v.camera.position.distanceTo(v.controls.target) / (v.model.measures.top - v.model.measures.chin);
+    });
+    await canvas.focus();
+    for (let i = 0; i < 40; i++) await page.keyboard.press('+');
+    const [near, nearShown] = [await distance(), await shown()];
+    for (let i = 0; i < 80; i++) await page.keyboard.press('-');
+    const [far, farShown] = [await distance(), await shown()];
+    console.log(`zoomed in all the way: ${near.toFixed(2)} face heights away, the face covers ${(100 * nearShown).toFixed(0)}%; out: ${far.toFixed(1)}, ${(100 * farShown).toFixed(1)}%`);
+    expect(near, 'zoomed in all the way: outside the head').toBeGreaterThanOrEqual(1.19);
+    expect(far).toBeLessThanOrEqual(8.01);
+    expect(farShown, 'zoomed out all the way: the face is still there to see').toBeGreaterThan(0.02);
+  });
+
   test('draws without multisampling where WebGL is software, with it where the renderer is a GPU', async ({ page }) => {
     // Here WebGL is SwiftShader: the canvas's context was made without antialias (src/render/software-gl.ts).
     const antialias = () => document.querySelector<HTMLCanvasElement>('#face-canvas')!.getContext('webgl2')!.getContextAttributes()!.antialias;
@@ -87,6 +106,15 @@ test('at phone width every control is reachable without sideways scrolling, and 
   await page.keyboard.press('Enter');
   await expect(page.locator('body')).toHaveAttribute('data-recording', 'error', { timeout: 20_000 });
   expect((await imageStats(page, await page.locator('#face-canvas').screenshot())).foregroundFraction).toBeGreaterThan(0.1);
+});
+
+test('on a phone on its side the face leaves room below it: a swipe there scrolls to the controls (one on the face orbits it)', async ({ page }) => {
+  await page.setViewportSize({ width: 667, height: 375 });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-ready', 'true');
+  const canvas = (await page.locator('#face-canvas').boundingBox())!;
+  expect(canvas.y + canvas.height, 'the face ends above the fold, with room under it').toBeLessThan(0.8 * 375);
+  await expect(page.locator('#timeline')).toBeInViewport();
 });
 
 test('reports a missing template in the page instead of a blank screen', async ({ page, guard }) => {
