@@ -11,9 +11,9 @@
  */
 import type * as Ort from 'onnxruntime-web';
 import { ModelLoadError } from '../model/artefacts';
-import { STALL_SECONDS } from '../model/fetch-body';
+import { fetchBody, STALL_SECONDS } from '../model/fetch-body';
 import { checkFeeds, type ExecutionProvider, type Feeds, type SessionSpec } from './onnx-spec';
-import { markRequested, ortRoot, ortThreads, OrtWorker, sessionOptions, setRuntimeStallSeconds, WorkerRunner, type Outputs, type Runner } from './ort-worker-client';
+import { getRuntimeStallSeconds, markRequested, ortRoot, ortThreads, OrtWorker, sessionOptions, setRuntimeStallSeconds, WorkerRunner, type Outputs, type Runner } from './ort-worker-client';
 export { sessionsRequested } from './ort-worker-client';
 
 export type { ExecutionProvider } from './onnx-spec';
@@ -35,14 +35,35 @@ export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
 
 const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
 
-/** onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker). */
+/** The plain build's runtime (vite.config.ts copies it under ort/<version>/). */
+const RUNTIME_FILE = 'ort-wasm-simd-threaded.wasm';
+
+/**
+ * onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker).
+ * The plain build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker:
+ * onnxruntime's own loader falls back to a synchronous request when its fetch fails, which a stalled connection holds
+ * forever. (The WebGPU build, used only on a hardware GPU, which no test here has, still fetches its own.) A failed
+ * load is forgotten, so the next one tries again.
+ */
 export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
-  ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then((ort) => {
+  ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then(async (ort) => {
     ort.env.wasm.numThreads = ortThreads();
     // onnxruntime reports node placement notes as warnings through console.error; keep real errors only.
     ort.env.logLevel = 'error';
-    ort.env.wasm.wasmPaths = `${ortRoot()}${ort.env.versions.web}/`;
+    const root = `${ortRoot()}${ort.env.versions.web}/`;
+    ort.env.wasm.wasmPaths = root;
+    if (build === 'jsep') return ort;
+    const url = `${root}${RUNTIME_FILE}`;
+    const failed = (why: string) => new ModelLoadError(`onnxruntime's runtime ${url} could not be downloaded (${why}); reload or try again`);
+    const runtime = await fetchBody(url, { stallSeconds: getRuntimeStallSeconds() }).catch((e: Error) => {
+      throw failed(e.message);
+    });
+    if (!runtime.ok) throw failed(`HTTP ${runtime.status}`);
+    ort.env.wasm.wasmBinary = new Uint8Array(runtime.bytes);
     return ort;
+  }).catch((e: unknown) => {
+    delete ortModules[build];
+    throw e;
   });
   return ortModules[build];
 }

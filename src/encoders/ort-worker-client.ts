@@ -205,6 +205,10 @@ export function setRuntimeStallSeconds(seconds: number): void {
   runtimeStallSeconds = seconds;
 }
 
+export function getRuntimeStallSeconds(): number {
+  return runtimeStallSeconds;
+}
+
 export function sessionOptions(provider: ExecutionProvider): Ort.InferenceSession.SessionOptions {
   return { executionProviders: [provider], graphOptimizationLevel: 'all', logSeverityLevel: 3 };
 }

@@ -53,10 +53,13 @@ test('a face whose WebGL context the browser takes says so, and again when it is
   await expect.poll(status, { timeout: 10_000 }).toBe('The face is drawn again.');
 });
 
-test('onnxruntime\'s runtime download brings nothing: the load fails after stallSeconds, naming it, instead of loading forever', async ({ page, context, guard }) => {
-  test.setTimeout(90_000);
-  await context.route('**/ort/*/ort-wasm-simd-threaded.wasm', () => undefined); // never answered
-  await page.goto('/dev/ort-start.html?stallSeconds=2');
-  await expect(page.locator('body')).toHaveAttribute('data-engine', 'error', { timeout: 45_000 });
-  expect(await page.locator('body').getAttribute('data-error')).toMatch(/ort-wasm.*nothing arrived for 2 s/s);
-});
+for (const where of ['its worker', 'the page (no Web Workers)'] as const) {
+  test(`onnxruntime's runtime download brings nothing, in ${where}: the load fails after stallSeconds, naming it, instead of loading forever`, async ({ page, context }) => {
+    test.setTimeout(90_000);
+    if (where !== 'its worker') await page.addInitScript(() => Object.defineProperty(globalThis, 'Worker', { value: undefined }));
+    await context.route('**/ort/*/ort-wasm-simd-threaded.wasm', () => undefined); // never answered
+    await page.goto('/dev/ort-start.html?stallSeconds=2');
+    await expect(page.locator('body')).toHaveAttribute('data-engine', 'error', { timeout: 45_000 });
+    expect(await page.locator('body').getAttribute('data-error')).toMatch(/ort-wasm.*nothing arrived for 2 s/s);
+  });
+}
