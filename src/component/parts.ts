@@ -15,7 +15,9 @@ canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
  * A canvas for a view. Each view gets a new one: a second WebGL renderer on a canvas whose context a first one used
  * inherits that context's state (pixel-store flags three.js believes unset), and uploads fail.
  */
-export function newCanvas(name = 'Animated 3D face'): HTMLCanvasElement {
+export function newCanvas(host: Element): HTMLCanvasElement {
+  // The element's own name, where the page gave it one (two faces on a page are told apart).
+  const name = host.getAttribute('aria-label') || 'Animated 3D face';
   const canvas = document.createElement('canvas');
   canvas.setAttribute('part', 'canvas');
   canvas.tabIndex = 0;
@@ -37,7 +39,7 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   if (internals) internals.role = 'group';
   const style = document.createElement('style');
   style.textContent = STYLE;
-  const canvas = newCanvas(host.getAttribute('aria-label') || undefined);
+  const canvas = newCanvas(host);
   const status = document.createElement('p');
   status.className = 'status';
   status.setAttribute('part', 'status');

@@ -29,10 +29,9 @@ export class ElementStage {
    */
   async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, headBone: string | null): Promise<boolean> {
     const token = (this.token = {});
-    const host = (this.canvas.getRootNode() as ShadowRoot).host as HTMLElement | undefined;
-    // The element's own name, where the page gave it one (two faces on a page are told apart).
-    const canvas = newCanvas(host?.getAttribute('aria-label') || undefined);
-    const focused = (this.canvas.getRootNode() as ShadowRoot).activeElement === this.canvas;
+    const root = this.canvas.getRootNode() as ShadowRoot; // the element's
+    const canvas = newCanvas(root.host);
+    const focused = root.activeElement === this.canvas;
     this.canvas.replaceWith(canvas);
     this.canvas = canvas;
     if (focused) canvas.focus(); // a keyboard user on the face while it loaded stays on it

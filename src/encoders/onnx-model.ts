@@ -11,7 +11,8 @@
  */
 import type * as Ort from 'onnxruntime-web';
 import { ModelLoadError } from '../model/artefacts';
-import { fetchBody, STALL_SECONDS } from '../model/fetch-body';
+import { STALL_SECONDS } from '../model/fetch-body';
+import { fetchRuntime } from './ort-runtime';
 import { checkFeeds, type ExecutionProvider, type Feeds, type SessionSpec } from './onnx-spec';
 import { getRuntimeStallSeconds, markRequested, ortRoot, ortThreads, OrtWorker, sessionOptions, setRuntimeStallSeconds, WorkerRunner, type Outputs, type Runner } from './ort-worker-client';
 export { sessionsRequested } from './ort-worker-client';
@@ -35,14 +36,10 @@ export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
 
 const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
 
-/** The plain build's runtime (vite.config.ts copies it under ort/<version>/). */
-const RUNTIME_FILE = 'ort-wasm-simd-threaded.wasm';
-
 /**
  * onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker).
- * The plain build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker:
- * onnxruntime's own loader falls back to a synchronous request when its fetch fails, which a stalled connection holds
- * forever. (The WebGPU build, used only on a hardware GPU, which no test here has, still fetches its own.) A failed
+ * The plain build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker
+ * (ort-runtime.ts). (The WebGPU build, used only on a hardware GPU, which no test here has, still fetches its own.) A failed
  * load is forgotten, so the next one tries again.
  */
 export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
@@ -53,13 +50,9 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     const root = `${ortRoot()}${ort.env.versions.web}/`;
     ort.env.wasm.wasmPaths = root;
     if (build === 'jsep') return ort;
-    const url = `${root}${RUNTIME_FILE}`;
-    const failed = (why: string) => new ModelLoadError(`onnxruntime's runtime ${url} could not be downloaded (${why}); reload or try again`);
-    const runtime = await fetchBody(url, { stallSeconds: getRuntimeStallSeconds() }).catch((e: Error) => {
-      throw failed(e.message);
+    ort.env.wasm.wasmBinary = await fetchRuntime(root, getRuntimeStallSeconds()).catch((e: Error) => {
+      throw new ModelLoadError(`onnxruntime's runtime ${e.message}; reload or try again`);
     });
-    if (!runtime.ok) throw failed(`HTTP ${runtime.status}`);
-    ort.env.wasm.wasmBinary = new Uint8Array(runtime.bytes);
     return ort;
   }).catch((e: unknown) => {
     delete ortModules[build];

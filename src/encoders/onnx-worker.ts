@@ -10,7 +10,7 @@
  *   worker -> page  { id, error } where a job failed.
  */
 import * as ort from 'onnxruntime-web/wasm';
-import { fetchBody } from '../model/fetch-body';
+import { fetchRuntime } from './ort-runtime';
 
 type Feed = { type: 'float32' | 'int64'; data: Float32Array | BigInt64Array; dims: number[] };
 type Message =
@@ -21,8 +21,6 @@ type Message =
 
 const sessions = new Map<number, ort.InferenceSession>();
 let queue: Promise<unknown> = Promise.resolve();
-/** The plain WebAssembly build's runtime (vite.config.ts copies it under the page's ort/ folder). */
-const RUNTIME_FILE = 'ort-wasm-simd-threaded.wasm';
 /** Its download, started by 'init': sessions are created once it is in. */
 let runtime: Promise<void> = Promise.resolve();
 
@@ -58,15 +56,12 @@ self.onmessage = (e: MessageEvent<Message>) => {
     ort.env.wasm.wasmPaths = root;
     ort.env.wasm.numThreads = m.numThreads;
     ort.env.logLevel = 'error';
-    // The runtime's WebAssembly is fetched here, not by onnxruntime: its loader falls back to a synchronous request
-    // when its fetch fails, which waits forever on a stalled connection. fetchBody fails after stallSeconds instead,
-    // and the sessions' creation then fails naming the runtime (onnx-model.ts reads "no available backend").
-    const url = `${root}${RUNTIME_FILE}`;
-    runtime = fetchBody(url, { stallSeconds: m.stallSeconds }).then((r) => {
-      if (!r.ok) throw new Error(`HTTP ${r.status}`);
-      ort.env.wasm.wasmBinary = new Uint8Array(r.bytes);
-    }).catch((e: Error) => {
-      throw new Error(`no available backend: ${url} could not be downloaded (${e.message})`);
+    // The runtime's WebAssembly is fetched here, not by onnxruntime (ort-runtime.ts): a download that fails or
+    // stalls fails the sessions' creation, naming the runtime (onnx-model.ts reads "no available backend").
+    runtime = fetchRuntime(root, m.stallSeconds).then((bytes) => {
+      ort.env.wasm.wasmBinary = bytes;
+    }, (e: Error) => {
+      throw new Error(`no available backend: ${e.message}`);
     });
     runtime.catch(() => undefined); // deliberate: read by the first session's creation
     // The reply proves that the page's messages reach this worker (until the page's thread has had a turn after
