@@ -119,17 +119,18 @@ export class LipTimeline {
     };
     if (d.truthGap) curve(d.truthGap, COLOURS.truth, 1);
     curve(d.gap, COLOURS.pred, 1.5);
-    // Heard phones: one label per run of two frames or more, /p b m/ in red.
+    // Heard phones: one label per run of two frames or more, /p b m/ in red, just under the lip curves.
+    const heard: [string, number][] = [];
     for (let f = 0; f < d.heard.length;) {
       let g = f;
       while (g < d.heard.length && d.heard[g] === d.heard[f]) g++;
       const p = d.heard[f];
-      if (g - f >= 2 && p !== 'SIL' && p !== '<blank>') this.label(ctx, p, (this.x(f, w) + this.x(g - 1, w)) / 2, h - labelRow / 2);
+      if (g - f >= 2 && p !== 'SIL' && p !== '<blank>') heard.push([p, (this.x(f, w) + this.x(g - 1, w)) / 2]);
       f = g;
     }
-    for (const [p, a, b] of d.truthPhones ?? []) {
-      if (p !== 'SIL') this.label(ctx, p, this.x(((a + b) / 2) * d.fps, w), labelRow / 2);
-    }
+    this.labels(ctx, heard, bottom + labelRow / 2);
+    this.labels(ctx, (d.truthPhones ?? []).filter(([p]) => p !== 'SIL')
+      .map(([p, a, b]): [string, number] => [p, this.x(((a + b) / 2) * d.fps, w)]), labelRow / 2);
     if (d.head) this.drawHead(ctx, w, h - headBand, h, d);
   }
 
@@ -164,9 +165,34 @@ export class LipTimeline {
     ctx.fillText(`head ±${max.toFixed(1)}°: pitch, yaw, roll`, 4 * dpr, top + 7 * dpr);
   }
 
-  private label(ctx: CanvasRenderingContext2D, phone: string, x: number, y: number): void {
-    ctx.fillStyle = BILABIALS.has(phone) ? COLOURS.bilabial : COLOURS.text;
+  /** One row of phone labels centred on their x, those that would overlap another left out (labelsThatFit). */
+  private labels(ctx: CanvasRenderingContext2D, phones: [string, number][], y: number): void {
     ctx.textAlign = 'center';
-    ctx.fillText(phone.toLowerCase(), x, y);
+    const sized = phones.map(([p, x]) => ({ x, width: ctx.measureText(p.toLowerCase()).width, first: BILABIALS.has(p) }));
+    for (const i of labelsThatFit(sized, 3 * devicePixelRatio)) {
+      const [phone, x] = phones[i];
+      ctx.fillStyle = BILABIALS.has(phone) ? COLOURS.bilabial : COLOURS.text;
+      ctx.fillText(phone.toLowerCase(), x, y);
+    }
   }
+}
+
+/**
+ * Which labels of a row to draw so that none overlaps another (a narrow timeline, a phone's, has less room than a
+ * clip has phones): those marked `first` (/p b m/, what the row is there to show) before the others, each left to
+ * right, and a label that would come within `gap` of one already kept left out. Labels are centred on their x.
+ * -> the indices kept, in order.
+ */
+export function labelsThatFit(labels: readonly { x: number; width: number; first: boolean }[], gap: number): number[] {
+  const order = labels.map((_, i) => i)
+    .sort((a, b) => Number(labels[b].first) - Number(labels[a].first) || labels[a].x - labels[b].x);
+  const taken: [number, number][] = [];
+  const kept: number[] = [];
+  for (const i of order) {
+    const left = labels[i].x - labels[i].width / 2, right = labels[i].x + labels[i].width / 2;
+    if (taken.some(([l, r]) => left < r + gap && l < right + gap)) continue;
+    taken.push([left, right]);
+    kept.push(i);
+  }
+  return kept.sort((a, b) => a - b);
 }

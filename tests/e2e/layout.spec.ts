@@ -118,3 +118,41 @@ test('on a phone the status line stays on screen, scrolled or not, and covers no
     if (y > 0) expect(r.under, 'controls under the status bar at the end of the page').toEqual([]);
   }
 });
+
+test.describe('under a finger (a coarse pointer)', () => {
+  test.use({ hasTouch: true, viewport: { width: 375, height: 667 } });
+
+  test('every control is at least 24 px tall and no select zooms the page when tapped', async ({ page }) => {
+    await page.goto('/');
+    await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+    expect(await page.evaluate(() => matchMedia('(pointer: coarse)').matches), 'the pointer is coarse').toBe(true);
+    const controls = await page.evaluate(() => [...document.querySelectorAll(
+      'section.controls button:not([hidden]), section.controls select, section.controls input:not([type=file]), .file-button span, #details summary')]
+      // A checkbox is hit through its label, which toggles it.
+      .map((el) => ({ id: el.id || el.textContent!.trim(), tag: el.tagName, font: parseFloat(getComputedStyle(el).fontSize),
+        height: ((el as HTMLInputElement).type === 'checkbox' ? el.closest('label')! : el).getBoundingClientRect().height })));
+    expect(controls.length).toBeGreaterThan(10);
+    expect(controls.filter((c) => c.height < 24).map((c) => `${c.id} ${c.height.toFixed(1)} px`), 'controls under 24 px').toEqual([]);
+    // Safari on iOS zooms the page into a select or text field whose text is under 16 px when it is tapped.
+    expect(controls.filter((c) => c.tag === 'SELECT' && c.font < 16).map((c) => `${c.id} ${c.font} px`), 'selects under 16 px').toEqual([]);
+  });
+});
+
+test('on a phone, when a take has played, the controls its message names are on screen, not under the status line', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.setViewportSize({ width: 375, height: 667 });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await page.locator('#sample-select').selectOption((await page.locator('#sample-select option').nth(1).getAttribute('value'))!);
+  await expect(page.locator('#status')).toContainText('press Play', { timeout: 60_000 });
+  await expect(page.locator('#status')).toContainText('open another file');
+  const r = await page.evaluate(() => ({
+    scrolled: scrollY,
+    bar: document.querySelector('.status-bar')!.getBoundingClientRect().top,
+    play: document.getElementById('play-button')!.getBoundingClientRect().bottom,
+    open: document.querySelector('#file-input + span')!.getBoundingClientRect().bottom,
+  }));
+  expect(r.scrolled, 'the page was not scrolled').toBe(0);
+  expect(r.play, 'Play above the status line').toBeLessThanOrEqual(r.bar);
+  expect(r.open, '"Open an audio file…" above the status line').toBeLessThanOrEqual(r.bar);
+});
