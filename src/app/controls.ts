@@ -51,7 +51,7 @@ export function enableControls(s: ControlsState): void {
   const playable = s.take && !s.recording;
   for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
   ui.headRerollButton.disabled = ui.headScale.disabled = !playable || !s.headMotion || (s.busy && !s.headRedraw);
-  ui.recordButton.disabled = s.busy;
+  ui.recordButton.disabled = s.busy && !s.recording; // while a take is finished it keeps the focus (aria-disabled)
   // Cancel hides once the work ends: its focus goes to what comes next, not to the page's start.
   if (!s.busy && document.activeElement === ui.cancelButton) (playable ? ui.playButton : ui.recordButton).focus();
   ui.cancelButton.hidden = !s.busy;

@@ -40,13 +40,10 @@ let takeNote = '';
 let recordPending = false;
 
 function publish(): void {
-  Object.assign(globalThis, {
-    talkingFace: {
-      view, template: view?.template, gpu: lastGpu, engine, take, truthView: takeView?.truthView ?? null,
-      exportGlb: async () => (take && engine ? exportGlb(take.animation, view.template, engine.unitsPerMm) : null),
-      inspectGlb, innerLipGaps,
-    },
-  });
+  Object.assign(globalThis, { talkingFace: {
+    view, template: view?.template, gpu: lastGpu, engine, take, truthView: takeView?.truthView ?? null, inspectGlb, innerLipGaps,
+    exportGlb: async () => (take && engine ? exportGlb(take.animation, view.template, engine.unitsPerMm) : null),
+  } });
 }
 
 /**
@@ -244,6 +241,8 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
     const update = () => {
       if (recording !== r) return;
       ui.takeInfo.textContent = r.describe();
+      const slow = r.slowNote();
+      if (slow) tell(slow);
       setTimeout(update, 250);
     };
     update();
@@ -258,8 +257,13 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
   ui.recordButton.textContent = 'Record';
   ui.recordButton.classList.remove('recording');
   tell('Recording stopped; finishing the take…');
+  const controller = new AbortController(); // Cancel and Escape stop the take's animation, where it needs one
+  const reanimating = (f: number, all: number) => {
+    if (!busy) setBusy(controller); // Record stays enabled (aria-disabled: toggleRecording), with the focus
+    showStatus(`Animating the whole take (frames were skipped live to keep up): frame ${f} of ${all}…`);
+  };
   try {
-    const done = await r.finish(() => showStatus('Animating the whole take (some frames were skipped live to keep up)…'));
+    const done = await r.finish(reanimating, controller.signal);
     if (!done) return tell('The take was too short to animate. Press Record and speak for a moment.', true);
     const speech = await e.restUnlessSpeech(done.animation);
     const notes = audioNotes(done.samples, done.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
@@ -268,9 +272,11 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     tell(takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';
   } catch (err) {
-    tell(`The recording could not be finished: ${(err as Error).message}`, true);
+    if (controller.signal.aborted) tell('Stopped finishing the recording: the take is discarded. Press Record to record again.');
+    else tell(`The recording could not be finished: ${(err as Error).message}`, true);
   } finally {
     finishing = false;
+    if (busy === controller) setBusy(null);
     refreshControls();
   }
 }
@@ -299,11 +305,7 @@ bindControls({
   setLoop: (on) => (player.loop = on),
   setArrows: (on) => takeView.setArrows(on),
   repaint: () => takeView.paint(take, engine, player.current, player.isPlaying),
-  setSideBySide: (on) => {
-    takeView.setSideBySide(on, take);
-    publish();
-    if (take) player.show(player.current);
-  },
+  setSideBySide: (on) => { takeView.setSideBySide(on, take); publish(); if (take) player.show(player.current); },
   pick: (at) => takeView.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
@@ -312,13 +314,8 @@ bindControls({
 });
 
 bindDetailsPanel();
-bindKeys({
-  escape,
-  hasTake: () => take !== null,
-  togglePlay,
-  step: (delta) => showFrame(player.current + delta),
-  view: () => view ?? null, // null until the face is drawn
-});
+// The view is null until the face is drawn.
+bindKeys({ escape, hasTake: () => take !== null, togglePlay, step: (delta) => showFrame(player.current + delta), view: () => view ?? null });
 for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
 
 start().catch((e: Error) => {

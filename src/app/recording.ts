@@ -17,6 +17,7 @@ export interface FinishedTake {
 
 export class Recording {
   private readonly frames: Frames[] = [];
+  private toldSlow = false;
 
   private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
 
@@ -35,6 +36,16 @@ export class Recording {
     return recording;
   }
 
+  /**
+   * Once, when the device first falls behind live (frames skipped to keep up), the status line that says so; else null.
+   * A visitor sees a face that moves in jumps, and is told why, not only in the details.
+   */
+  slowNote(): string | null {
+    if (this.toldSlow || !this.live.stream.skippedFrames) return null;
+    this.toldSlow = true;
+    return 'Recording: this device is slower than real time, so the face skips frames to keep up (the take is animated whole when you stop). Stop recording or Escape stops.';
+  }
+
   /** One line on the live state: seconds, decoder, latency, frames skipped. */
   describe(): string {
     const lat = this.live.stream.latency;
@@ -44,10 +55,11 @@ export class Recording {
   }
 
   /**
-   * Stop and return the take, or null when it is too short to animate (under 0.1 s). `onReanimate` is told
-   * when the whole take must be animated again because frames were skipped live.
+   * Stop and return the take, or null when it is too short to animate (under 0.1 s). When frames were skipped live,
+   * the whole take is animated again: `onReanimate` is told its progress (frames done of all), and `signal` cancels it
+   * (the promise rejects with the abort's reason).
    */
-  async finish(onReanimate: () => void): Promise<FinishedTake | null> {
+  async finish(onReanimate: (done: number, total: number) => void, signal?: AbortSignal): Promise<FinishedTake | null> {
     const e = this.engine;
     const samples = await this.live.stop();
     const rate = e.manifest.audio.sample_rate;
@@ -62,8 +74,8 @@ export class Recording {
       animation = joinFrames(this.frames, e.fps);
     } else {
       // The device fell behind while live (frames were skipped to stay live): animate the take again, whole.
-      onReanimate();
-      animation = await e.animate(samples, { unposed: true });
+      onReanimate(0, e.frameCount(samples.length));
+      animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
     }
     return { animation, buffer, samples, seconds: samples.length / rate, computeMs };
   }

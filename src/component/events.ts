@@ -1,5 +1,6 @@
 /** What <talking-face> sends with its events (docs/embedding.md, "Events"). */
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
+import type { StreamSession } from '../engine/stream';
 import type { AvatarSummary } from '../avatar/gltf-avatar';
 import { frameWeights, type FrameWeights } from '../avatar/weights';
 import { SHORT_CLIP_SECONDS } from '../player/player';
@@ -24,6 +25,11 @@ export interface FrameDetail extends Partial<FrameWeights> {
   /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
   inferenceMs?: number;
   latencyMs?: number;
+  /**
+   * Live: frames skipped so far to stay live (0 while the device keeps up). Above 0 the device is slower than real
+   * time: the face shows fewer frames than the voice has, and a page may say so or lighten its own work.
+   */
+  skippedFrames?: number;
   /** Offline: seconds of audio per second of compute. */
   realTimeFactor?: number;
 }
@@ -52,11 +58,12 @@ export function playbackFrameDetail(engine: TalkingFaceEngine, a: Animation, fra
   };
 }
 
-/** The last frame of a live chunk (frames first ..), with the stream's measured latency. */
-export function liveFrameDetail(engine: TalkingFaceEngine, first: number, frames: Frames, latencyMs: number | undefined): FrameDetail {
+/** The last frame of a live chunk (frames first ..), with the stream's measured latency and the frames it skipped. */
+export function liveFrameDetail(engine: TalkingFaceEngine, first: number, frames: Frames, stream: StreamSession | undefined): FrameDetail {
   const last = frames.count - 1;
   return {
-    frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend, latencyMs,
+    frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend,
+    latencyMs: stream?.latency.lastMs, skippedFrames: stream?.skippedFrames ?? 0,
     ...(frames.blendshapes && frameWeights(frames.blendshapes, last)),
   };
 }

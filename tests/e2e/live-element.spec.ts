@@ -106,3 +106,27 @@ for (const avatar of [null, '/examples/avatars/arkit-face.glb']) test(`between p
   }
   expect(seen.join(''), 'at rest, speaking, at rest').toMatch(pattern);
 });
+
+test('live frame events count the frames skipped to stay live, and a device that falls behind raises the count', async ({ page }) => {
+  test.setTimeout(90_000);
+  await page.evaluate(() => {
+    const g = globalThis as unknown as { skipped: number[] };
+    g.skipped = [];
+    document.getElementById('left')!.addEventListener('frame', (e) => {
+      const d = (e as CustomEvent).detail;
+      if (d.mode === 'live') g.skipped.push(d.skippedFrames);
+    });
+  });
+  const skipped = () => page.evaluate(() => (globalThis as unknown as { skipped: number[] }).skipped);
+  await start(page);
+  await expect.poll(async () => (await skipped()).length, { timeout: 20_000 }).toBeGreaterThan(3);
+  const before = (await skipped()).length;
+  // A slow device: the page's thread held for 1.5 s (45 frames of speech), far beyond the live lag limit (15 frames).
+  await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 1500); });
+  await expect.poll(async () => (await skipped()).length, { timeout: 10_000 }).toBeGreaterThan(before + 2);
+  await page.evaluate(() => (document.getElementById('left') as unknown as { stop(): void }).stop());
+  const s = await skipped();
+  expect(s.every((n, i) => Number.isInteger(n) && n >= (s[i - 1] ?? 0)), `a count that only grows: ${s}`).toBe(true);
+  // The first drain after the hold skips (one in flight across the hold may come first).
+  expect(Math.max(...s.slice(before, before + 2)) - s[before - 1], `frames skipped over the held 1.5 s: ${s}`).toBeGreaterThanOrEqual(20);
+});

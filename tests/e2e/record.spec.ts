@@ -90,3 +90,40 @@ test("while recording, the last take's playback rests; a file opened while the r
   await page.locator('#play-button').click();
   await expect(page.locator('#play-button')).toHaveText('Pause');
 });
+
+test('a take whose live frames were skipped is animated again with progress; Escape stops that and says the take is discarded', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const record = page.locator('#record-button');
+  await record.focus();
+  await page.keyboard.press('Enter');
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
+  await page.waitForTimeout(1500);
+  // A slow device: the page's thread held for 1.5 s, more than the live lag limit (15 frames), so frames are skipped.
+  await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 1500); });
+  await expect(page.locator('#take-info')).toContainText('frames skipped to keep up', { timeout: 20_000 });
+  // The visitor is told, on the status line, not only in the details.
+  await expect(page.locator('#status')).toContainText('this device is slower than real time, so the face skips frames');
+  await page.waitForTimeout(1000);
+  // Watch the status: at its first progress line, press Escape (before the next chunk of the animation runs).
+  await page.evaluate(() => {
+    const g = globalThis as unknown as { statuses: string[] };
+    g.statuses = [];
+    const status = document.getElementById('status')!;
+    new MutationObserver(() => {
+      g.statuses.push(status.textContent ?? '');
+      if (/frame \d+ of \d+/.test(status.textContent ?? '') && !g.statuses.some((s) => s.startsWith('Stopped'))) {
+        document.activeElement!.dispatchEvent(new KeyboardEvent('keydown', { key: 'Escape', bubbles: true }));
+      }
+    }).observe(status, { childList: true, characterData: true, subtree: true });
+  });
+  await page.keyboard.press('Enter'); // Stop recording
+  await expect(page.locator('#status')).toHaveText('Stopped finishing the recording: the take is discarded. Press Record to record again.', { timeout: 30_000 });
+  const statuses = await page.evaluate(() => (globalThis as unknown as { statuses: string[] }).statuses);
+  expect(statuses.some((s) => /^Animating the whole take .*: frame 0 of \d+…$/.test(s)), statuses.join(' | ')).toBe(true);
+  await expect(page.locator('body')).not.toHaveAttribute('data-take', 'ready');
+  await expect(page.locator('#cancel-button')).toBeHidden();
+  await expect(record, 'the focus stays on Record, enabled again').toBeFocused();
+  await expect(record).toBeEnabled();
+});
