@@ -186,3 +186,16 @@ def test_evaluate_says_what_its_figures_are_measured_against_without_alignments_
     assert evaluate.main(["--corpus", str(copy), "--checkpoint", str(trained_run / "final.pt"), "--out", str(out), "--head-draws", "1"]) == 0
     assert json.loads(out.read_text())["missing"] == ["phone alignments"]
     assert "**Note**: the dataset has no phone alignments" in out.with_suffix(".md").read_text()
+
+
+def test_train_without_alignments_needs_a_front_end(corpus, trained_run, tmp_path, capsys):
+    """Real data has no phone alignments: the content encoder would learn silence, so training asks for --frontend."""
+    copy = tmp_path / "no-alignments"
+    shutil.copytree(corpus.root, copy)
+    shutil.rmtree(copy / "alignments")
+    with pytest.raises(SystemExit) as e:
+        train.main(["--corpus", str(copy), "--out", str(tmp_path / "run"), "--steps", "1"])
+    assert e.value.code == 2
+    assert "has no phone alignments" in capsys.readouterr().err and not (tmp_path / "run" / "final.pt").exists()
+    assert train.main(["--corpus", str(copy), "--out", str(tmp_path / "run"), "--steps", "1",
+                       "--frontend", str(trained_run / "final.pt")]) == 0

@@ -39,10 +39,10 @@ def test_processed_vocaset(tmp_path):
     """FaceFormer's process_voca_data.py layout: 60 fps, subject_sentenceNN, latin-1 templates.pkl."""
     mesh, masks = write_mesh_template(tmp_path)
     train, test = "FaceTalk_170728_03272_TA", "FaceTalk_170809_00138_TA"
-    raw = write_clip(tmp_path, f"{train}_sentence01", 10)
-    write_clip(tmp_path, f"{train}_sentence40", 10)
-    write_clip(tmp_path, f"{test}_sentence05", 10)   # test subjects use sentences 21-40 only
-    write_clip(tmp_path, f"{test}_sentence21", 10)
+    raw = write_clip(tmp_path, f"{train}_sentence01", 30)  # 0.5 s at 60 fps
+    write_clip(tmp_path, f"{train}_sentence40", 30)
+    write_clip(tmp_path, f"{test}_sentence05", 30)   # test subjects use sentences 21-40 only
+    write_clip(tmp_path, f"{test}_sentence21", 30)
     with open(tmp_path / "templates.pkl", "wb") as f:
         pickle.dump({train: np.zeros((N, 3)), test: np.ones((N, 3))}, f, protocol=2)
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
@@ -50,8 +50,8 @@ def test_processed_vocaset(tmp_path):
     assert ds.keys("train") == [f"{train}_sentence01", f"{train}_sentence40"]
     assert ds.keys("test") == [f"{test}_sentence21"]
     clip = ds.load(f"{train}_sentence01")
-    assert clip.subject == train and clip.num_frames == 5  # 60 -> 30 fps
-    np.testing.assert_array_equal(clip.vertices.reshape(5, -1), raw[::2])
+    assert clip.subject == train and clip.num_frames == 15  # 60 -> 30 fps
+    np.testing.assert_array_equal(clip.vertices.reshape(15, -1), raw[::2])
     np.testing.assert_array_equal(ds.load(f"{test}_sentence21").template, np.ones((N, 3)))
     assert clip.pose is None and clip.phones is None
 
@@ -100,3 +100,76 @@ def test_a_clip_whose_audio_is_not_wav_is_reported_with_its_key(tmp_path):
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
     with pytest.raises(DatasetError, match="clip S1_01: .* is not a WAV file"):
         ds.load("S1_01")
+
+
+def own_dataset(root, keys, frames=30):
+    """A VOCASET-layout dataset of the user's own subjects (not VOCA's), 0.5 s clips at 60 fps."""
+    mesh, masks = write_mesh_template(root)
+    for k in keys:
+        write_clip(root, k, frames)
+    with open(root / "templates.pkl", "wb") as f:
+        pickle.dump({k.split("_sentence")[0]: np.zeros((N, 3)) for k in keys}, f)
+    return mesh, masks
+
+
+def test_own_subjects_are_split_by_splits_json_and_an_empty_split_says_how(tmp_path):
+    keys = ["alice_sentence01", "alice_sentence02", "bob_sentence01"]
+    mesh, masks = own_dataset(tmp_path, keys)
+    ds = open_dataset(tmp_path, template=mesh, masks=masks)
+    with pytest.raises(DatasetError, match=r"no clip is in the 'train' split.*VOCA split.*alice, bob.*splits\.json"):
+        ds.keys("train")
+    (tmp_path / "splits.json").write_text(json.dumps({"train": keys[:2], "val": [], "test": keys[2:]}))
+    ds = open_dataset(tmp_path, template=mesh, masks=masks)
+    assert ds.keys("train") == keys[:2] and ds.keys("test") == ["bob_sentence01"]
+    with pytest.raises(DatasetError, match=r"no clip is in the 'val' split. The splits are those of .*splits\.json"):
+        ds.keys("val")
+    (tmp_path / "splits.json").write_text(json.dumps({"train": ["carol_sentence01"]}))
+    with pytest.raises(DatasetError, match="'train' names clips that .* does not have: carol_sentence01"):
+        open_dataset(tmp_path, template=mesh, masks=masks)
+    (tmp_path / "splits.json").write_text("{train: }")
+    with pytest.raises(DatasetError, match="not valid JSON"):
+        open_dataset(tmp_path, template=mesh, masks=masks)
+
+
+def test_names_without_a_sentence_number_are_refused_with_the_pattern(tmp_path):
+    mesh, masks = own_dataset(tmp_path, ["alice_sentenceA1"])
+    with pytest.raises(DatasetError, match="SUBJECT_sentenceNN"):
+        open_dataset(tmp_path, template=mesh, masks=masks)
+
+
+@pytest.mark.parametrize("fault, message", [
+    ("nan", "NaN or infinite"),
+    ("long", r"90 frames at 30 fps are 3.00 s, but its audio is 0.50 s"),
+    ("short", r"3 frames at 30 fps are 0.10 s, but its audio is 0.50 s"),
+    ("object", "not a plain numeric array"),
+])
+def test_a_clip_with_bad_vertices_is_refused_naming_it(tmp_path, fault, message):
+    mesh, masks = own_dataset(tmp_path, ["alice_sentence01"])
+    (tmp_path / "splits.json").write_text(json.dumps({"train": ["alice_sentence01"]}))
+    path = tmp_path / "vertices_npy" / "alice_sentence01.npy"
+    if fault == "nan":
+        v = np.load(path)
+        v[4, 4] = np.nan  # an even frame: the 60 fps layout reads every other one
+        np.save(path, v)
+    elif fault in ("long", "short"):
+        np.save(path, np.zeros((180 if fault == "long" else 6, N * 3), np.float32))
+    else:
+        np.save(path, np.array([{"not": "vertices"}], dtype=object), allow_pickle=True)
+    ds = open_dataset(tmp_path, template=mesh, masks=masks)
+    with pytest.raises(DatasetError, match=f"alice_sentence01.*{message}"):
+        ds.load("alice_sentence01")
+
+
+def test_templates_pkl_faults_are_named(tmp_path):
+    mesh, masks = own_dataset(tmp_path, ["alice_sentence01"])
+    (tmp_path / "splits.json").write_text(json.dumps({"train": ["alice_sentence01"]}))
+    for faces, message in [({"alice": np.zeros((N + 1, 3))}, "subject 'alice' has 10 vertices, the template 9"),
+                           ({"alice": np.full((N, 3), np.nan)}, "'alice'.*NaN or infinite")]:
+        with open(tmp_path / "templates.pkl", "wb") as f:
+            pickle.dump(faces, f)
+        with pytest.raises(DatasetError, match=message):
+            open_dataset(tmp_path, template=mesh, masks=masks)
+    with open(tmp_path / "templates.pkl", "wb") as f:
+        pickle.dump({"bob": np.zeros((N, 3))}, f)
+    with pytest.raises(DatasetError, match="templates.pkl has no neutral face for subject 'alice' \\(it has bob\\)"):
+        open_dataset(tmp_path, template=mesh, masks=masks).load("alice_sentence01")

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import pickle
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -78,7 +79,24 @@ class FaceDataset:
     def keys(self, split: str) -> list[str]:
         if split not in self.splits:
             raise DatasetError(f"{self.root}: no split {split!r} (have {', '.join(self.splits)})")
+        if not self.splits[split]:
+            raise DatasetError(f"{self.root}: no clip is in the {split!r} split. {self._split_rule()}")
         return self.splits[split]
+
+    def _split_rule(self) -> str:
+        """How this dataset's clips are split, for a message about an empty split."""
+        own = f"To split your own clips, list their names in {self.root / 'splits.json'}: " \
+              f'{{"train": ["alice_sentence01", ...], "val": [...], "test": [...]}}.'
+        if self.layout == "corpus" or (self.root / "splits.json").is_file():
+            return f"The splits are those of {self.root / 'splits.json'}."
+        subjects = sorted({self.subject_of(p.stem) for p in (self.root / "vertices_npy").glob("*.npy")})
+        if self.layout == "vocaset":
+            rule = "; ".join(f"{name}: {subjects_.split()[0]} and {len(subjects_.split()) - 1} more VOCA subjects, "
+                             f"sentences {r.start}-{r.stop - 1}" for name, (subjects_, r) in VOCASET_SPLITS.items())
+            return f"Without splits.json the VOCA split applies, by subject and sentence ({rule}); this dataset's " \
+                   f"subjects are {', '.join(subjects) or 'none'}. {own}"
+        return f"Without splits.json FaceDiffuser's Multiface split applies, by sentence number " \
+               f"(train 1-40, val 41-45, test 46-50). {own}"
 
     def subject_of(self, key: str) -> str:
         if self.layout == "vocaset":
@@ -91,10 +109,23 @@ class FaceDataset:
             audio, sr = read_wav(self.root / "wav" / f"{key}.wav")
         except WavError as e:  # the dataset's error, naming the clip; the WAV reader's reason kept
             raise DatasetError(f"clip {key}: {e}") from e
-        verts = np.load(self._file("vertices_npy", key, ".npy"))[:: self._frame_step]
+        try:
+            verts = np.load(self._file("vertices_npy", key, ".npy"))[:: self._frame_step]
+        except ValueError as e:  # a pickled object array, a truncated file
+            raise DatasetError(f"clip {key}: vertices_npy/{key}.npy is not a plain numeric array: {e}") from e
         n = self.template.num_vertices
         if verts.ndim != 2 or verts.shape[1] != n * 3:
             raise DatasetError(f"{key}: vertices have shape {verts.shape}, expected (frames, {n * 3}) for template {self.template.id}")
+        if not np.isfinite(verts).all():
+            raise DatasetError(f"clip {key}: vertices_npy/{key}.npy holds NaN or infinite values")
+        seconds, frames_seconds = len(audio) / sr, len(verts) / self.fps
+        if abs(seconds - frames_seconds) > max(0.25, 0.1 * seconds):  # alignment tools leave a few frames either way
+            raise DatasetError(
+                f"clip {key}: {len(verts)} frames at {self.fps:g} fps are {frames_seconds:.2f} s, but its audio is "
+                f"{seconds:.2f} s (the {self.layout} layout reads vertices at {self.fps * self._frame_step:g} fps)")
+        if subject not in self.subject_templates:
+            raise DatasetError(f"clip {key}: templates.pkl has no neutral face for subject {subject!r} "
+                               f"(it has {', '.join(sorted(self.subject_templates)) or 'none'})")
         clip = Clip(key, subject, audio, sr, self.fps, verts.reshape(-1, n, 3).astype(np.float32),
                     self.subject_templates[subject].reshape(n, 3).astype(np.float32))
         # Poses and alignments are optional for a dataset (VOCASET has neither), not for a clip of one that has them:
@@ -129,16 +160,42 @@ def open_dataset(root: str | Path, template: str | Path | None = None, masks: st
     if not keys:
         raise DatasetError(f"{root}/vertices_npy has no .npy files")
     tpl = _real_template(root, template, masks)
-    subject_templates = _read_templates_pkl(root)
-    if any("_sentence" in k for k in keys):
+    subject_templates = _read_templates_pkl(root, tpl.num_vertices)
+    vocaset = any("_sentence" in k for k in keys)
+    for k in keys:  # the subject and the sentence number come from the name
+        if not re.fullmatch(r".+_sentence\d+" if vocaset else r".+_\d+", k):
+            raise DatasetError(f"{root}/vertices_npy/{k}.npy: names are SUBJECT_sentenceNN (VOCASET) or SUBJECT_NN "
+                               f"(Multiface), NN the sentence's number" + ("" if vocaset else "; VOCASET's names contain '_sentence'"))
+    if vocaset:
         splits = {}
         for split, (subjects, sentences) in VOCASET_SPLITS.items():
             subs = set(subjects.split())
-            splits[split] = [k for k in keys if k.split("_sentence")[0] in subs and int(k[-2:]) in sentences]
-        # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
+            splits[split] = [k for k in keys if k.split("_sentence")[0] in subs and int(k.split("_sentence")[1]) in sentences]
+    else:
+        splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
+    if (root / "splits.json").is_file():
+        splits = _own_splits(root, keys)
+    if vocaset:  # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
         return FaceDataset(root, "vocaset", tpl, 30.0, 1000.0, splits, subject_templates, _frame_step=2)
-    splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
     return FaceDataset(root, "multiface", tpl, 30.0, 1.0, splits, subject_templates)
+
+
+def _own_splits(root: Path, keys: list[str]) -> dict[str, list[str]]:
+    """ROOT/splits.json, {"train": [clip names], "val": [...], "test": [...]}, checked against the clips there."""
+    path = root / "splits.json"
+    try:
+        splits = json.loads(path.read_text())
+    except json.JSONDecodeError as e:
+        raise DatasetError(f"{path} is not valid JSON: {e}") from e
+    if not isinstance(splits, dict) or not all(isinstance(v, list) for v in splits.values()):
+        raise DatasetError(f'{path}: expected {{"train": [clip names], "val": [...], "test": [...]}}')
+    have = set(keys)
+    for split, names in splits.items():
+        missing = [n for n in names if n not in have]
+        if missing:
+            raise DatasetError(f"{path}: {split!r} names clips that {root}/vertices_npy does not have: {', '.join(missing[:5])}"
+                               + (f" and {len(missing) - 5} more" if len(missing) > 5 else ""))
+    return splits
 
 
 def _open_corpus(root: Path) -> FaceDataset:
@@ -153,18 +210,27 @@ def _open_corpus(root: Path) -> FaceDataset:
 
 def _real_template(root: Path, template: str | Path | None, masks: str | Path | None) -> Template:
     path = Path(template) if template else root / "template" / "template.json"
+    if template and not path.exists():
+        raise DatasetError(f"the template {path} (--template) does not exist")
     if not path.exists():
         raise DatasetError(
-            f"{root}: a real dataset needs its template with region masks: pass template=... (and masks=...) "
+            f"{root}: a real dataset needs its template with region masks: pass --template (and --masks) "
             f"or put it at {path} (docs/templates.md)")
     return load_template(path, masks)
 
 
-def _read_templates_pkl(root: Path) -> dict[str, np.ndarray]:
+def _read_templates_pkl(root: Path, vertices: int | None = None) -> dict[str, np.ndarray]:
+    """templates.pkl, subject -> neutral face; with `vertices`, each checked to have that many, and finite."""
     path = root / "templates.pkl"
     if not path.exists():
         raise DatasetError(f"{root} has no templates.pkl (subject -> neutral vertices)")
     with open(path, "rb") as f:
         # VOCASET's templates.pkl is a Python 2 pickle of numpy arrays (FaceFormer: encoding='latin1').
         data = pickle.load(f, encoding="latin1")
-    return {k: np.asarray(v, dtype=np.float32) for k, v in data.items()}
+    faces = {k: np.asarray(v, dtype=np.float32) for k, v in data.items()}
+    for subject, face in faces.items():
+        if vertices is not None and face.size != vertices * 3:
+            raise DatasetError(f"{path}: subject {subject!r} has {face.size // 3} vertices, the template {vertices}")
+        if not np.isfinite(face).all():
+            raise DatasetError(f"{path}: subject {subject!r}'s neutral face holds NaN or infinite values")
+    return faces

@@ -29,6 +29,7 @@ from ..model import lip_closure as lc
 from ..model.config import ModelConfig
 from ..model.gava import TalkingFace, count_parameters
 from ..paths import REPO_ROOT, TEMPLATE_DIR
+from ..phones import PHONE_INDEX, SILENCE
 from ..cli import CheckpointError, check_device, check_run_folder, read_checkpoint, require_positive, term_as_interrupt
 from ..template import Template, TemplateFormatError, load_template
 from . import packed
@@ -168,6 +169,10 @@ def main(argv=None) -> int:
     audio = AudioConfig(fps=int(fps))
     if not args.packed:
         clips = [prepare(ds, k, audio) for k in ds.keys("train")]
+    if not (args.frontend and not args.tune_frontend) and all((c.phones == PHONE_INDEX[SILENCE]).all() for c in clips):
+        parser().error(f"{args.corpus or args.packed} has no phone alignments (alignments/, as VOCASET has none), so the content "
+                 "encoder would learn to hear only silence: pass --frontend models/checkpoint.pt (the shipped speech "
+                 "front-end, frozen) or one of your own (talkingface.frontend.train)")
     frontend = load_frontend(args.frontend) if args.frontend else None
     content_keys = ("content_arch", "content_channels", "content_classes", "content_stride", "content_ahead")
     content_cfg = {k: getattr(ModelConfig.from_dict(frontend["model_config"]), k) for k in content_keys} if frontend else {}
