@@ -136,6 +136,15 @@ def test_an_export_elsewhere_carries_the_face_template(trained_run, tmp_path):
     assert there.with_suffix(".bin").exists()
 
 
+def test_an_export_into_another_models_folder_is_refused_in_one_line(trained_run, tmp_path):
+    out = tmp_path / "exported"
+    (out / "template").mkdir(parents=True)
+    (out / "template" / "template.json").write_text(json.dumps({"id": "someone-else"}))
+    result = run_module("talkingface.export", "--checkpoint", str(trained_run / "final.pt"), "--out", str(out))
+    assert result.returncode == 2 and len(result.stderr.strip().splitlines()) == 1, result.stderr
+    assert "is template 'someone-else', but the model was trained on" in result.stderr
+
+
 def test_corpus_build_refuses_nonsense_counts(tmp_path):
     for bad in (["--sentences", "0"], ["--sentences", "-1"], ["--subjects", "1", "0", "0"], ["--workers", "0"]):
         res = run_module("talkingface.corpus", "build", "--preset", "small", "--out", str(tmp_path / "c"), *bad)

@@ -39,7 +39,7 @@ from .paths import MODELS_DIR, REPO_ROOT, TEMPLATE_DIR
 from .phones import CONTENT_CLASSES
 from .safetensors import sha256, write_safetensors
 from .cli import read_checkpoint
-from .template import Template, load_template
+from .template import Template, TemplateFormatError, load_template
 
 MANIFEST_FORMAT = "talking-face-model"
 MANIFEST_VERSION = 2  # 2: hierarchical.onnx gives the latents [a, g]; the browser's decoder makes the vertex tokens
@@ -164,7 +164,7 @@ def check_out_template(out: Path, template: Template) -> None:
     """The browser loads the face from OUT/template/template.json: where one is there, it must be this model's."""
     there = out / "template" / "template.json"
     if there.exists() and (other := json.loads(there.read_text()).get("id")) != template.id:
-        raise ValueError(f"{there} is template {other!r}, but the model was trained on {template.id!r}: "
+        raise TemplateFormatError(f"{there} is template {other!r}, but the model was trained on {template.id!r}: "
                          "export to another folder, or put the model's template there")
 
 
