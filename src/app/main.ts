@@ -276,8 +276,8 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     else tell(`The recording could not be finished: ${(err as Error).message}`, true);
   } finally {
     finishing = false;
-    if (busy === controller) setBusy(null);
-    refreshControls();
+    if (busy === controller) setBusy(null); // which refreshes the controls
+    else refreshControls();
   }
 }
 

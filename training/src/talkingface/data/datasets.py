@@ -166,15 +166,15 @@ def open_dataset(root: str | Path, template: str | Path | None = None, masks: st
         if not re.fullmatch(r".+_sentence\d+" if vocaset else r".+_\d+", k):
             raise DatasetError(f"{root}/vertices_npy/{k}.npy: names are SUBJECT_sentenceNN (VOCASET) or SUBJECT_NN "
                                f"(Multiface), NN the sentence's number" + ("" if vocaset else "; VOCASET's names contain '_sentence'"))
-    if vocaset:
+    if (root / "splits.json").is_file():
+        splits = _own_splits(root, keys)
+    elif vocaset:
         splits = {}
         for split, (subjects, sentences) in VOCASET_SPLITS.items():
             subs = set(subjects.split())
             splits[split] = [k for k in keys if k.split("_sentence")[0] in subs and int(k.split("_sentence")[1]) in sentences]
     else:
         splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
-    if (root / "splits.json").is_file():
-        splits = _own_splits(root, keys)
     if vocaset:  # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
         return FaceDataset(root, "vocaset", tpl, 30.0, 1000.0, splits, subject_templates, _frame_step=2)
     return FaceDataset(root, "multiface", tpl, 30.0, 1.0, splits, subject_templates)
