@@ -128,9 +128,12 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   expect(glb.bytes).toBeLessThan(2e6); // per-frame targets would be ~100 MB
   expect(glb.maxErrorMm).toBeLessThan(1); // a millimetre at most anywhere on the face, on any frame
   // The page says what it did (after a progress it shows while the page stays live: seconds of work, more on a busy machine).
+  const first = page.waitForEvent('download', { timeout: 90_000 });
   await page.locator('#export-glb').click();
   await expect(page.locator('#status')).toContainText(/Preparing the \.glb of \d+ frames: \d+%/);
   await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/, { timeout: 90_000 });
+  // The browser reports that download on its own time, after the page has said so: wait for it before counting the next.
+  expect((await first).suggestedFilename()).toBe('seventy.glb');
   // Escape cancels one being prepared: nothing is saved, and the page says so.
   const saved: string[] = [];
   page.on('download', (d) => saved.push(d.suggestedFilename()));
