@@ -83,6 +83,15 @@ export function precompress(dir: string): void {
 const ENCODINGS: [token: string, suffix: string][] = [['br', '.br'], ['gzip', '.gz']];
 
 /**
+ * A compressed copy to serve for `file`: there, and not older than the file by more than a copy of the build takes
+ * between the two (`cp -r` gives each the time it was copied). A file replaced in a build (a model exported over
+ * dist/models/) is served as it is now, not as its stale copy said it was.
+ */
+function fresh(file: string, copy: string): boolean {
+  return existsSync(copy) && statSync(copy).mtimeMs >= statSync(file).mtimeMs - 2000;
+}
+
+/**
  * Serve the files of the build under `root` (GET and HEAD): the precompressed copy the browser accepts, its
  * Cache-Control, an ETag (a 304 when it matches), and the cross-origin isolation headers. A missing file is a 404;
  * a missing page and a Range request go on to the next middleware.
@@ -100,7 +109,7 @@ export function serveBuild(root: string) {
       return;
     }
     const accept = String(req.headers['accept-encoding'] ?? '');
-    const [encoding, suffix] = ENCODINGS.find(([token, sfx]) => new RegExp(`\\b${token}\\b`).test(accept) && existsSync(file + sfx)) ?? ['', ''];
+    const [encoding, suffix] = ENCODINGS.find(([token, sfx]) => new RegExp(`\\b${token}\\b`).test(accept) && fresh(file, file + sfx)) ?? ['', ''];
     const served = file + suffix;
     const st = statSync(served);
     const etag = `"${st.size.toString(36)}-${Math.floor(st.mtimeMs).toString(36)}${encoding ? `-${encoding}` : ''}"`;

@@ -1,6 +1,6 @@
 /** How the build is served (scripts/hosting.ts): cache headers by path, precompressed copies, ETags, 404s. */
 import { createServer, request, type IncomingHttpHeaders, type Server } from 'node:http';
-import { mkdtempSync, mkdirSync, writeFileSync, existsSync } from 'node:fs';
+import { mkdtempSync, mkdirSync, writeFileSync, existsSync, utimesSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
@@ -66,6 +66,19 @@ describe('serveBuild', () => {
     const again = await get(`${base}/assets/app-abcdEF12.js`, { 'accept-encoding': 'br', 'if-none-match': String(res.headers.etag) });
     expect(again.status).toBe(304);
     expect(brotliDecompressSync(body).toString()).toBe(text);
+  });
+
+  it('sends a file replaced after the build as it is now, not its older compressed copy', async () => {
+    const replaced = 'console.log("replaced");\n'.repeat(200);
+    writeFileSync(join(root, 'assets/late.js'), text);
+    precompress(root);
+    const old = new Date(Date.now() - 60_000);
+    utimesSync(join(root, 'assets/late.js.br'), old, old);
+    utimesSync(join(root, 'assets/late.js.gz'), old, old);
+    writeFileSync(join(root, 'assets/late.js'), replaced);
+    const res = await get(`${base}/assets/late.js`, { 'accept-encoding': 'br, gzip' });
+    expect(res.headers['content-encoding']).toBeUndefined();
+    expect(res.body.toString()).toBe(replaced);
   });
 
   it('sends the file as is where no encoding is accepted, serves / as index.html, and 404s a missing file', async () => {
