@@ -81,9 +81,14 @@ async function start(): Promise<void> {
     if (!gpu.available) ui.backendSelect.querySelector<HTMLOptionElement>('option[value="webgpu"]')!.disabled = true;
     publish();
     ui.setupInfo.textContent += ` Model ${engine.manifest.model.name}. ${decoderDetails(engine)}`;
-    tell('Ready: open or drop an audio file, choose a sample, or press Record.');
+    const ready = 'Ready: open or drop an audio file, choose a sample, or press Record.';
+    tell(ready);
     document.body.dataset.engine = 'ready';
-    void fillSampleSelect(ui.sampleSelect).then((index) => (sampleIndex = index));
+    void fillSampleSelect(ui.sampleSelect).then((index) => {
+      sampleIndex = index;
+      // A model served without sample clips: the message names only what there is (if nothing has been said since).
+      if (!index && ui.status.textContent === ready) tell('Ready: open or drop an audio file, or press Record.');
+    });
     engine.restFace().then((rest) => {
       view.setRestFace(rest); // the mouth closed at rest, not the opened template
       document.body.dataset.rest = 'shown';

@@ -3,7 +3,8 @@ import { test, expect } from './fixtures';
 /**
  * <talking-face> when its files do not arrive (examples/embed.html): a model whose load failed (onnxruntime's runtime
  * not downloaded; a model file's connection dropped) loads on the next speak() once the network is back, and shows
- * its face; the errors name the file; a face whose WebGL context the browser takes (16 a page) says so.
+ * its face; the errors name the file; a face whose WebGL context the browser takes (16 a page) says so; the demo
+ * served without its sample clips does not offer them.
  */
 type El = HTMLElement & { speak(a: unknown): Promise<void>; ready: Promise<unknown> };
 
@@ -63,3 +64,13 @@ for (const where of ['its worker', 'the page (no Web Workers)'] as const) {
     expect(await page.locator('body').getAttribute('data-error')).toMatch(/ort-wasm.*nothing arrived for 2 s/s);
   });
 }
+
+test('the demo served without sample clips offers only what there is', async ({ page, context, guard }) => {
+  test.setTimeout(60_000);
+  guard.allowConsoleError(/Failed to load resource/);
+  await context.route('**/models/samples/index.json', (r) => r.fulfill({ status: 404, body: 'not here' }));
+  await page.goto('/');
+  await expect(page.locator('#status')).toHaveText('Ready: open or drop an audio file, or press Record.', { timeout: 60_000 });
+  await expect(page.locator('#sample-select')).toBeDisabled();
+  await expect(page.locator('#sample-select')).toHaveAttribute('title', 'No sample clips: HTTP 404');
+});
