@@ -168,6 +168,7 @@ def main(argv=None) -> int:
         template_path = args.template or str(Path(args.corpus) / "template" / "template.json")
     audio = AudioConfig(fps=int(fps))
     if not args.packed:
+        log(f"preparing {len(ds.keys('train'))} training clips (log-Mel, phones, faces: about 20 s per 500 clips)")
         clips = [prepare(ds, k, audio) for k in ds.keys("train")]
     if not (args.frontend and not args.tune_frontend) and all((c.phones == PHONE_INDEX[SILENCE]).all() for c in clips):
         parser().error(f"{args.corpus or args.packed} has no phone alignments (alignments/, as VOCASET has none), so the content "
