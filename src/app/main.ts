@@ -235,7 +235,7 @@ async function toggleRecording(): Promise<void> {
 async function startRecording(e: TalkingFaceEngine): Promise<void> {
   stopPlayback();
   try {
-    const r = await Recording.start(e, (f) => player.showLive(f), (err) => tell(`Live animation stopped: ${err.message}`, true));
+    const r = await Recording.start(e, (f) => player.showLive(f, e.fps), (err) => tell(`Live animation stopped: ${err.message}`, true));
     stopPlayback(); // played while the microphone opened
     recording = r;
     refreshControls();

@@ -177,7 +177,7 @@ export class TalkingFaceElement extends HTMLElement {
     try {
       live = await engine.listen(media, (first: number, frames: Frames) => {
         if (gen !== this.generation || !this.stage.player) return;
-        this.stage.player.showLive(frames);
+        this.stage.player.showLive(frames, engine.fps);
         this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream) }));
       }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
         onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),

@@ -72,6 +72,13 @@ export interface PlayerOptions {
 const AUTOPLAY_WAIT_MS = 300;
 /** Live frames without speech after which the face goes back to rest (showLive): a breath between words does not. */
 const LIVE_REST_FRAMES = 12;
+/**
+ * Live frames come in batches when the device is slow (a batch per engine run): they are shown one after another,
+ * each this fraction of a frame's time after the last (a little faster than real time, so a backlog drains) ...
+ */
+const LIVE_SPACING = 0.8;
+/** ... and at most this far behind their batch (ms): older ones are dropped rather than shown late. */
+const LIVE_BACKLOG_MS = 250;
 /** The events that count as a person's gesture for the autoplay rules. */
 const GESTURES = ['pointerdown', 'pointerup', 'keydown', 'touchend'] as const;
 
@@ -92,6 +99,10 @@ export class Player {
   private playing: Playing | null = null;
   private currentFrame = 0;
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
+  private liveQueue: { frames: Frames; f: number; due: number }[] = []; // live frames to show, each at its time
+  private liveTick = 0; // the animation frame that shows them (0: none asked)
+  /** Live frames shown so far: those of a batch that came faster than the display shows frames pass unseen. */
+  liveShown = 0;
   private forgetGesture: () => void = () => undefined; // removes the listeners awaitGesture left on the document
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
@@ -139,18 +150,47 @@ export class Player {
   }
 
   /**
-   * Show the last frame of a streamed chunk (live). After LIVE_REST_FRAMES frames without speech the face goes back
-   * to rest, and its life (blinks, breathing) with it, until speech comes again.
+   * Show streamed frames (live) at the model's `fps`: a batch of several (a device slower than the stream computes
+   * them together) is played out frame by frame rather than jumping to its last, so a lip closure inside a batch is
+   * seen. After LIVE_REST_FRAMES frames without speech the face goes back to rest, and its life (blinks, breathing)
+   * with it, until speech comes again.
    */
-  showLive(frames: Frames): void {
-    const last = frames.count - 1;
-    const n3 = frames.unposed.length / frames.count;
-    for (let f = 0; f < frames.count; f++) this.liveQuiet = frames.speech[f] > SPEECH_PROBABILITY ? 0 : this.liveQuiet + 1;
-    this.view.setTongue?.(frames.tongue[last] ?? 0);
-    this.view.setVertices(frames.unposed.subarray(last * n3, (last + 1) * n3));
-    this.view.setSpeaking?.(this.liveQuiet < LIVE_REST_FRAMES);
-    if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, last);
-    this.pose(frames.pose.subarray(last * 6, last * 6 + 6));
+  showLive(frames: Frames, fps: number): void {
+    const now = performance.now();
+    const spacing = (LIVE_SPACING * 1000) / fps;
+    let due = this.liveQueue.at(-1)?.due ?? -Infinity;
+    for (let f = 0; f < frames.count; f++) this.liveQueue.push({ frames, f, due: (due = Math.max(now, due + spacing)) });
+    const over = this.liveQueue.length - Math.floor(LIVE_BACKLOG_MS / spacing) - 1;
+    if (over > 0) {
+      for (const q of this.liveQueue.splice(0, over)) this.countSpeech(q.frames, q.f);
+      this.liveQueue.forEach((q, i) => (q.due = now + i * spacing));
+    }
+    this.liveTick ||= requestAnimationFrame(this.showDue);
+  }
+
+  /** Show the newest live frame that is due (those before it pass unseen, as on a display slower than the model's fps). */
+  private showDue = (): void => {
+    this.liveTick = 0;
+    const now = performance.now();
+    let n = 0;
+    while (n < this.liveQueue.length && this.liveQueue[n].due <= now) n++;
+    if (n > 0) {
+      const shown = this.liveQueue.splice(0, n);
+      for (const q of shown) this.countSpeech(q.frames, q.f);
+      const { frames, f } = shown[n - 1];
+      const n3 = frames.unposed.length / frames.count;
+      this.view.setTongue?.(frames.tongue[f] ?? 0);
+      this.view.setVertices(frames.unposed.subarray(f * n3, (f + 1) * n3));
+      this.view.setSpeaking?.(this.liveQuiet < LIVE_REST_FRAMES);
+      if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, f);
+      this.pose(frames.pose.subarray(f * 6, f * 6 + 6));
+      this.liveShown++;
+    }
+    if (this.liveQueue.length) this.liveTick = requestAnimationFrame(this.showDue);
+  };
+
+  private countSpeech(frames: Frames, f: number): void {
+    this.liveQuiet = frames.speech[f] > SPEECH_PROBABILITY ? 0 : this.liveQuiet + 1;
   }
 
   private pose(p: Float32Array): void {
@@ -237,6 +277,9 @@ export class Player {
   stop(): void {
     this.forgetGesture(); // a player stopped (or removed with its element) waits for no gesture: nor keeps its view alive
     this.liveQuiet = LIVE_REST_FRAMES; // a live session after this starts at rest, whatever the last one ended on
+    this.liveQueue = [];
+    if (this.liveTick) cancelAnimationFrame(this.liveTick);
+    this.liveTick = 0;
     const p = this.playing;
     if (!p) return;
     this.playing = null;

@@ -2,7 +2,7 @@
  * The shared player (src/player/player.ts) on a stand-in face view and audio clock: which frame it shows, where
  * the pose goes, the shape mapping, play / stop / end / loop, and the notes it writes about a clip's audio.
  */
-import { afterEach, beforeEach, describe, expect, it } from 'vitest';
+import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { Player, audioNotes, LONG_CLIP_SECONDS, SHORT_CLIP_SECONDS } from '../../../src/player/player';
 import type { FaceView } from '../../../src/render/face-view';
 import { emptyBlendshapes, type Animation } from '../../../src/engine/frames';
@@ -62,7 +62,7 @@ const tick = () => {
 };
 
 beforeEach(() => {
-  Object.assign(globalThis, { AudioContext: FakeContext, requestAnimationFrame: (cb: () => void) => frameCallbacks.push(cb) });
+  Object.assign(globalThis, { AudioContext: FakeContext, requestAnimationFrame: (cb: () => void) => frameCallbacks.push(cb), cancelAnimationFrame: () => undefined });
 });
 afterEach(() => {
   frameCallbacks = [];
@@ -92,11 +92,44 @@ describe('Player', () => {
     p.load(a, {} as AudioBuffer);
     p.show(2);
     expect(got).toEqual([[2, 0.5]]);
-    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), tongue: new Float32Array(3), speech: new Float32Array(3), blendshapes: a.blendshapes });
-    expect(got[1]).toEqual([2, 0.5]); // the chunk's last frame
+    p.showLive({ count: 3, vertices: new Float32Array(18), unposed: new Float32Array(18), pose: new Float32Array(18), phones: new Uint8Array(3), tongue: new Float32Array(3), speech: new Float32Array(3), blendshapes: a.blendshapes }, 10);
+    const now = vi.spyOn(performance, 'now').mockReturnValue(performance.now() + 1000);
+    tick();
+    now.mockRestore();
+    expect(got[1]).toEqual([2, 0.5]); // all three due: the last shown
     p.load(animation(4), {} as AudioBuffer); // a take without blend shapes: nothing to hand over
     p.show(1);
     expect(got).toHaveLength(2);
+  });
+
+  it('plays a batch of live frames out one by one at the frame rate, drops a backlog, and stop() clears it', () => {
+    const { view, shown } = fakeView();
+    const p = new Player(view, 1);
+    const live = (from: number, count: number) => {
+      const a = animation(from + count);
+      const n = count * 6;
+      return { count, vertices: a.vertices.slice(from * 6, from * 6 + n), unposed: a.unposed!.slice(from * 6, from * 6 + n),
+        pose: a.pose.slice(from * 6, from * 6 + n), phones: a.phones.slice(from, from + count), tongue: a.tongue.slice(from, from + count),
+        speech: a.speech.slice(from, from + count) };
+    };
+    let t = 1000;
+    const now = vi.spyOn(performance, 'now').mockImplementation(() => t);
+    const at = (ms: number) => {
+      t = 1000 + ms;
+      tick();
+      return shown.at(-1)?.vertices[0];
+    };
+    // 10 fps: frames 80 ms apart (a little under 100, so a backlog drains).
+    p.showLive(live(0, 3), 10);
+    expect([at(0), at(50), at(90), at(170), at(500)]).toEqual([0, 0, 1, 2, 2]);
+    expect(p.liveShown).toBe(3);
+    // Twenty at once: only the last ones within 250 ms of now are kept, the first of them shown at once.
+    p.showLive(live(3, 20), 10);
+    expect([at(500), at(580), at(660), at(740), at(2000)]).toEqual([19, 20, 21, 22, 22]);
+    p.showLive(live(23, 3), 10);
+    p.stop();
+    expect(at(3000)).toBe(22); // nothing more shown
+    now.mockRestore();
   });
 
   it('draws through the shape mapping when given one', () => {
