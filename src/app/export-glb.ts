@@ -7,10 +7,11 @@
  * - up to GLB_EXACT_FRAMES frames (10 s), exact: the neutral face as the mesh, one morph target per frame
  *   (that frame's I + O minus I) and a weights track that steps through them (one target on at a time); a viewer
  *   declares a uniform per target (three.js), and many GPUs allow about a thousand, so longer clips are not sent so;
- * - longer clips, compact: the mean face as the mesh and GLB_COMPONENTS morph targets, the strongest
- *   directions of the clip's motion (motion-basis.ts), with every frame's weights; the largest
- *   deviation from the exact frames is measured and reported. Eight is the number of simultaneous
- *   morph targets glTF asks every viewer to support, and the file grows by only 32 bytes a frame.
+ * - longer clips, compact: the mean face as the mesh and the GLB_COMPONENTS strongest directions of the clip's
+ *   motion (motion-basis.ts), each as two morph targets, its positive and its negative side, with every frame's
+ *   weights, all within 0..1 (importers such as Blender's keep a shape key's weight there); the largest deviation
+ *   from the exact frames is measured and reported. At most eight targets are weighted at once, the number glTF
+ *   asks every viewer to support, and the file grows by only 64 bytes a frame.
  * Also the raw per-frame vertices.
  */
 import * as THREE from 'three';
@@ -24,7 +25,7 @@ import { IdleMotion } from '../render/idle-motion';
 
 /** Longest clip exported with one morph target per frame (its weights track is frames x frames). */
 export const GLB_EXACT_FRAMES = 300;
-/** Morph targets in the compact encoding of longer clips. */
+/** Directions of motion in the compact encoding of longer clips (two morph targets each). */
 export const GLB_COMPONENTS = 8;
 /** Share of a long clip's export spent posing the head frame by frame (the rest finds its components; measured). */
 const POSING_SHARE = 0.05;
@@ -70,7 +71,7 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
   let maxErrorMm = 0;
   if (exact) {
     geometry.setAttribute('position', new THREE.BufferAttribute(base, 3));
-    for (let f = 0; f < frames; f++) targets.push(new THREE.BufferAttribute(D.subarray(f * dims, (f + 1) * dims), 3));
+    for (let f = 0; f < frames; f++) targets.push(named(D.subarray(f * dims, (f + 1) * dims), `frame_${f}`));
     weights = new Float32Array(frames * frames);
     for (let f = 0; f < frames; f++) weights[f * frames + f] = 1;
   } else {
@@ -80,8 +81,19 @@ export async function exportGlb(animation: Animation, template: FaceTemplate, un
     const mean = new Float32Array(dims);
     for (let i = 0; i < dims; i++) mean[i] = base[i] + m.mean[i];
     geometry.setAttribute('position', new THREE.BufferAttribute(mean, 3));
-    for (let k = 0; k < m.components; k++) targets.push(new THREE.BufferAttribute(m.basis.subarray(k * dims, (k + 1) * dims), 3));
-    weights = m.coefficients;
+    const K = m.components;
+    weights = new Float32Array(frames * 2 * K);
+    for (let k = 0; k < K; k++) {
+      let most = 0, least = 0; // the side's largest coefficient is its target's full weight
+      for (let f = 0; f < frames; f++) [most, least] = [Math.max(most, m.coefficients[f * K + k]), Math.min(least, m.coefficients[f * K + k])];
+      const direction = m.basis.subarray(k * dims, (k + 1) * dims);
+      targets.push(named(direction.map((v) => v * most), `motion_${k + 1}_plus`), named(direction.map((v) => v * least), `motion_${k + 1}_minus`));
+      for (let f = 0; f < frames; f++) {
+        const c = m.coefficients[f * K + k];
+        weights[f * 2 * K + 2 * k] = c > 0 ? c / most : 0;
+        weights[f * 2 * K + 2 * k + 1] = c < 0 ? c / least : 0;
+      }
+    }
     maxErrorMm = m.maxError / unitsPerMm;
   }
   geometry.morphAttributes.position = targets;
@@ -142,11 +154,19 @@ function gazeTracks(head: Head, times: Float32Array): THREE.KeyframeTrack[] {
   return tracks;
 }
 
+/** A morph target with its name (other tools show it: Blender's shape keys, three.js's morphTargetDictionary). */
+function named(values: Float32Array, name: string): THREE.BufferAttribute {
+  const a = new THREE.BufferAttribute(values, 3);
+  a.name = name;
+  return a;
+}
+
 /**
  * Re-load a .glb with three.js: the face mesh's morph targets and vertices, the animation clips, their duration,
  * the names of the head's parts, and which of them the clip animates.
  */
-export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[]; heightM: number }> {
+export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: number; targetNames: string[]; weightRange: [number, number];
+  clips: number; duration: number; vertices: number; parts: string[]; animated: string[]; heightM: number }> {
   const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
   const gltf = await new GLTFLoader().parseAsync(bytes, '');
   let face: THREE.Mesh | null = null;
@@ -156,8 +176,17 @@ export async function inspectGlb(bytes: ArrayBuffer): Promise<{ morphTargets: nu
     if (!face && (o as THREE.Mesh).isMesh && (o as THREE.Mesh).geometry.morphAttributes.position?.length) face = o as THREE.Mesh;
   });
   const m = face as THREE.Mesh | null;
+  const faceWeights = (gltf.animations[0]?.tracks ?? []).filter((t) => {
+    const node = gltf.scene.getObjectByName(t.name.split('.')[0]);
+    return t.name.endsWith('.morphTargetInfluences') && m && (node === m || node?.parent === m.parent);
+  });
+  const weightRange: [number, number] = [Infinity, -Infinity];
+  for (const t of faceWeights) for (const w of t.values) [weightRange[0], weightRange[1]] = [Math.min(weightRange[0], w), Math.max(weightRange[1], w)];
   return {
     morphTargets: m?.geometry.morphAttributes.position?.length ?? 0,
+    targetNames: Object.keys(m?.morphTargetDictionary ?? {}),
+    /** The face's morph-target weights, least and most, over the clip. */
+    weightRange,
     clips: gltf.animations.length,
     duration: gltf.animations[0]?.duration ?? 0,
     vertices: m?.geometry.getAttribute('position').count ?? 0,

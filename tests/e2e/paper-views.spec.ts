@@ -10,7 +10,7 @@ type TF = {
   take: { name: string; animation: { frames: number; fps: number }; truth?: { frames: number } } | null;
   view: { scene: { getObjectByName(n: string): unknown } };
   exportGlb(): Promise<{ bytes: ArrayBuffer; frames: number; encoding: string; morphTargets: number; maxErrorMm: number }>;
-  inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; clips: number; duration: number; vertices: number; parts: string[]; animated: string[]; heightM: number }>;
+  inspectGlb(b: ArrayBuffer): Promise<{ morphTargets: number; targetNames: string[]; weightRange: [number, number]; clips: number; duration: number; vertices: number; parts: string[]; animated: string[]; heightM: number }>;
 };
 /** Vertices of the whole head's skin buffer (face, then shell and mouth cavity): what the .glb's morphed mesh holds. */
 const headVertices = (page: import('@playwright/test').Page) =>
@@ -77,6 +77,8 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   expect(glb.frames).toBe(take.frames);
   expect(glb.encoding).toBe('per-frame');
   expect(glb.info.morphTargets).toBe(take.frames);
+  expect(glb.info.targetNames.slice(0, 2)).toEqual(['frame_0', 'frame_1']);
+  expect(glb.info.weightRange).toEqual([0, 1]);
   expect(glb.info.clips).toBe(1);
   expect(glb.info.vertices).toBe(await headVertices(page));
   expect(glb.info.vertices).toBeGreaterThan(468);
@@ -104,7 +106,7 @@ test('sample clip: heat map, side by side, pose arrows, attention maps, exports'
   await expect(page.locator('#gt-view')).toBeHidden();
 });
 
-test('a clip longer than a minute exports whole as a compact .glb: 8 morph targets, the deviation measured', async ({ page }) => {
+test('a clip longer than a minute exports whole as a compact .glb: 8 directions of motion, weights within 0..1, the deviation measured', async ({ page }) => {
   test.setTimeout(180_000);
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
@@ -122,7 +124,11 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   console.log(`70 s clip: ${glb.frames} frames as ${glb.morphTargets} morph targets, ${(glb.bytes / 1e6).toFixed(2)} MB, largest deviation ${glb.maxErrorMm.toFixed(3)} mm`);
   expect(glb.frames).toBe(frames);
   expect(glb.encoding).toBe('components');
-  expect(glb.info.morphTargets).toBe(8);
+  // Eight directions of motion, each a target per side, weighted within 0..1 (Blender keeps shape keys there).
+  expect(glb.info.morphTargets).toBe(16);
+  expect(glb.info.targetNames.slice(0, 3)).toEqual(['motion_1_plus', 'motion_1_minus', 'motion_2_plus']);
+  expect(glb.info.weightRange[0]).toBe(0);
+  expect(glb.info.weightRange[1]).toBeCloseTo(1, 6);
   expect(glb.info.vertices).toBe(await headVertices(page));
   expect(glb.info.duration).toBeCloseTo((frames - 1) / FPS, 3);
   expect(glb.bytes).toBeLessThan(2e6); // per-frame targets would be ~100 MB
@@ -131,7 +137,7 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 morph targe
   const first = page.waitForEvent('download', { timeout: 90_000 });
   await page.locator('#export-glb').click();
   await expect(page.locator('#status')).toContainText(/Preparing the \.glb of \d+ frames: \d+%/);
-  await expect(page.locator('#details')).toContainText(/8 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/, { timeout: 90_000 });
+  await expect(page.locator('#details')).toContainText(/16 morph targets with per-frame weights \(largest deviation from the exact frames: \d+\.\d\d mm\)/, { timeout: 90_000 });
   // The browser reports that download on its own time, after the page has said so: wait for it before counting the next.
   expect((await first).suggestedFilename()).toBe('seventy.glb');
   // Escape cancels one being prepared: nothing is saved, and the page says so.
