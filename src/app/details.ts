@@ -6,6 +6,7 @@ import type { FaceTemplate } from '../template/face-template';
 import type { WebGPUSupport } from '../gpu/capabilities';
 import type { Backend, TalkingFaceEngine } from '../engine/engine';
 import { tell, ui } from './controls';
+import { isolated } from './names';
 import { fmaModule, simdUnavailable } from '../attention/simd-kernel';
 import { SHORT_CLIP_SECONDS } from '../player/player';
 import type { Take } from './take-view';
@@ -27,7 +28,7 @@ export function takeDetails(t: Take, notes: string[]): string {
   const speed = t.seconds < SHORT_CLIP_SECONDS
     ? 'no speed figure for a clip this short'
     : `${(t.computeMs / t.animation.frames).toFixed(1)} ms per frame, ${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time`;
-  return `${t.name}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
+  return `${isolated(t.name)}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
 }
 
 /** Decode on `want` from now on (a clip being animated switches at its next chunk): say so, and keep the details' decoder line up to date. */

@@ -3,6 +3,7 @@ import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
 import { exportGlb, rawFrames, download, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
+import { fileBaseName, isolated } from './names';
 
 /** The .glb being prepared (a long clip's takes seconds): Escape cancels it (cancelExport). */
 let exporting: AbortController | null = null;
@@ -25,9 +26,9 @@ export async function exportGlbFile(animation: Animation, name: string, template
       signal: controller.signal,
       onProgress: (done) => showStatus(`${preparing}: ${Math.round(100 * done)}%… (Escape cancels)`),
     });
-    const file = `${baseName(name)}.glb`;
+    const file = `${fileBaseName(name)}.glb`;
     download(new Blob([glb.bytes], { type: 'model/gltf-binary' }), file);
-    tell(`Saved ${file}: the animation as a glTF model.`);
+    tell(`Saved ${isolated(file)}: the animation as a glTF model.`);
     ui.exportInfo.textContent = (`Exported ${glb.frames} frames as .glb (${(glb.bytes.byteLength / 1e6).toFixed(1)} MB)` +
       (glb.encoding === 'components'
         ? `: the clip is longer than ${GLB_EXACT_FRAMES} frames, so its motion is ${glb.morphTargets} morph targets with per-frame weights ` +
@@ -44,13 +45,8 @@ export async function exportGlbFile(animation: Animation, name: string, template
 
 export function exportRawFile(animation: Animation, name: string, template: FaceTemplate): void {
   const n = template.vertexCount;
-  const file = `${baseName(name)}.${animation.frames}x${n}x3.f32`;
+  const file = `${fileBaseName(name)}.${animation.frames}x${n}x3.f32`;
   download(rawFrames(animation), file);
-  tell(`Saved ${file}: the raw frames.`);
+  tell(`Saved ${isolated(file)}: the raw frames.`);
   ui.exportInfo.textContent = (`Exported ${animation.frames} frames x ${n} vertices x 3 as float32 (little-endian, ${template.units}, ${animation.fps} fps).`);
-}
-
-/** A take's name without its extension, for the files it is saved as ('take' where nothing is left: a file named ".wav"). */
-function baseName(name: string): string {
-  return name.replace(/\.[^.]+$/, '').trim() || 'take';
 }

@@ -16,7 +16,7 @@ import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './s
 import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { cancelExport, exportGlbFile, exportRawFile } from './export-ui';
-import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, type HeadChange } from './controls';
+import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, isolated, type HeadChange } from './controls';
 import { bindKeys } from './keyboard';
 import { innerLipGaps } from '../template/lip-gap';
 
@@ -150,12 +150,12 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
 }
 
 function animateFile(file: File): Promise<void> {
-  return animateTake(file.name, async (e, signal) => {
-    showStatus(`Decoding ${file.name}…`);
+  return animateTake(isolated(file.name), async (e, signal) => {
+    showStatus(`Decoding ${isolated(file.name)}…`);
     const audio = await decodeAudio(file, e.manifest.audio.sample_rate, signal); // Cancel need not wait for a long decode
     const src = audio.source;
     const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
-    ui.clipInfo.textContent = `${file.name}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
+    ui.clipInfo.textContent = `${isolated(file.name)}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
     return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
   });
 }
@@ -183,7 +183,7 @@ function setTake(t: Take, notes: string[] = []): Take {
   publish();
   ui.takeInfo.textContent = takeDetails(t, notes);
   ui.exportInfo.textContent = '';
-  takeNote = notes.length ? `${t.name}: ${notes[0]}.` : '';
+  takeNote = notes.length ? `${isolated(t.name)}: ${notes[0]}.` : '';
   ui.playButton.textContent = 'Play'; // loading it stopped any playback
   refreshControls();
   ui.scrub.max = String(t.animation.frames - 1);
@@ -195,13 +195,13 @@ function setTake(t: Take, notes: string[] = []): Take {
 
 /** The take's head motion drawn again, with the next seed or at a new scale (the lips and eyes do not change). */
 function redrawTakeHead(change: HeadChange): void {
-  if (engine?.hasHeadMotion && take) void animateTake(take.name, async (e, signal) => setTake(await redrawHead(e, take!, signal, change)), true);
+  if (engine?.hasHeadMotion && take) void animateTake(isolated(take.name), async (e, signal) => setTake(await redrawHead(e, take!, signal, change)), true);
 }
 
 function play(): void {
   if (!take) return;
   ui.playButton.textContent = 'Pause';
-  tell(takeNote ? `Playing. ${takeNote}` : `Playing ${take.name}: Space or Escape pauses.`);
+  tell(takeNote ? `Playing. ${takeNote}` : `Playing ${isolated(take.name)}: Space or Escape pauses.`);
   void player.play();
 }
 

@@ -9,7 +9,7 @@ import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { announce, headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
+import { announce, headScaleText, showLegend, showStatus, tell, ui, isolated, type HeadChange } from './controls';
 import { audioNotes } from '../player/player';
 import { raiseIfQuiet } from '../audio/decode';
 
@@ -184,7 +184,7 @@ export async function animateAudio(e: TalkingFaceEngine, name: string, given: Fl
   const animation = await e.animate(samples, {
     unposed: true,
     signal,
-    onProgress: (done, total) => showStatus(`Animating ${name}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
+    onProgress: (done, total) => showStatus(`Animating ${isolated(name)}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
   });
   const computeMs = performance.now() - t0;
   const speech = await e.restUnlessSpeech(animation);

@@ -30,6 +30,16 @@ export function frameOptions(el: Element): { blendshapes: boolean; headMotionSca
   return { blendshapes: el.hasAttribute('avatar') || el.hasAttribute('blendshapes'), headMotionScale: headMotionAttribute(el.getAttribute('head-motion')) };
 }
 
+/** A URL as a person wrote it ("Grüße.wav", not "Gr%C3%BC%C3%9Fe.wav"); as it is where it holds a malformed %-sequence. */
+function readable(url: string): string {
+  try {
+    return decodeURI(url);
+  } catch (e) {
+    if (e instanceof URIError) return url;
+    throw e;
+  }
+}
+
 /** speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is another origin's). */
 export async function audioInput(audio: Blob | AudioBuffer | URL | string): Promise<Blob | AudioBuffer> {
   if (audio instanceof Blob || (typeof AudioBuffer !== 'undefined' && audio instanceof AudioBuffer)) return audio;
@@ -38,7 +48,7 @@ export async function audioInput(audio: Blob | AudioBuffer | URL | string): Prom
     throw new TypeError(`speak() takes a Blob or File, an AudioBuffer, or a URL (got ${got})`);
   }
   const url = new URL(String(audio), document.baseURI);
-  const shown = url.origin === location.origin ? url.pathname : url.href;
+  const shown = readable(url.origin === location.origin ? url.pathname : url.href);
   const res = await fetchBody(url).catch((e: Error) => {
     throw new Error(`could not fetch ${shown}: ${e.message}`);
   });

@@ -3,9 +3,11 @@ import { CAMERA_KEYS_TEXT } from '../render/camera-keys';
 
 export const STYLE = `
 :host { display: block; position: relative; width: 100%; aspect-ratio: 4 / 3; min-height: 160px; background: #15181d; border-radius: 8px; overflow: hidden; contain: content; }
+:host([hidden]) { display: none; }
 canvas { display: block; width: 100%; height: 100%; outline: none; }
 canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
-.status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45); }
+.status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45);
+  text-align: start; text-transform: none; text-indent: 0; letter-spacing: normal; word-spacing: normal; white-space: normal; } /* not the page's */
 .status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
 :host([hide-status]) .status:not(.error) { display: none; } /* the announcer still speaks */
 .announce { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
@@ -45,6 +47,8 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   status.setAttribute('part', 'status');
   status.setAttribute('aria-hidden', 'true'); // the announcer says it once
   const announcer = document.createElement('span');
+  // The element speaks English, left to right, whatever the page's language and direction (a screen reader's voice).
+  for (const own of [status, announcer]) [own.lang, own.dir] = ['en', 'ltr'];
   announcer.className = 'announce';
   announcer.setAttribute('role', 'status');
   announcer.setAttribute('aria-live', 'polite');

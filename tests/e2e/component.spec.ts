@@ -69,3 +69,22 @@ test('a missing model gives an error event and message, and the page keeps worki
   await page.locator('#speak').click();
   await expect.poll(() => page.locator('#left').evaluate((el) => (el as FaceEl).currentAnimation?.frames ?? 0), { timeout: 60_000 }).toBeGreaterThan(0);
 });
+
+test('in a right-to-left page with its own text styles, the status stays English and readable; hidden hides it', async ({ page }) => {
+  test.setTimeout(60_000);
+  await page.goto('/examples/embed.html');
+  await page.evaluate(() => {
+    document.documentElement.lang = 'ar';
+    document.documentElement.dir = 'rtl';
+    document.body.style.cssText += ';text-transform: uppercase; letter-spacing: .25em; white-space: nowrap; text-indent: 3em';
+  });
+  await expect(page.locator('#left p.status')).toContainText('Ready', { timeout: 60_000 });
+  const status = await page.locator('#left p.status').evaluate((p) => {
+    const s = getComputedStyle(p);
+    return { lang: (p as HTMLElement).lang, direction: s.direction, textTransform: s.textTransform, letterSpacing: s.letterSpacing, whiteSpace: s.whiteSpace, textIndent: s.textIndent };
+  });
+  expect(status).toEqual({ lang: 'en', direction: 'ltr', textTransform: 'none', letterSpacing: 'normal', whiteSpace: 'normal', textIndent: '0px' });
+  await page.locator('#left').evaluate((el) => ((el as HTMLElement).hidden = true));
+  await expect(page.locator('#left')).toBeHidden();
+  expect(await page.locator('#left').evaluate((el) => el.getBoundingClientRect().height)).toBe(0);
+});

@@ -35,6 +35,8 @@ describe('<talking-face> attributes', () => {
     });
     await expect(audioInput('/missing.wav')).rejects.toThrow('could not fetch /missing.wav: HTTP 404');
     await expect(audioInput('https://elsewhere.test/a.wav')).rejects.toThrow('could not fetch https://elsewhere.test/a.wav: Failed to fetch');
+    await expect(audioInput('/Grüße 日本語.wav')).rejects.toThrow('could not fetch /Grüße 日本語.wav: Failed to fetch'); // as written, not %-encoded
+    await expect(audioInput('/100%E0.wav')).rejects.toThrow('could not fetch /100%E0.wav: Failed to fetch'); // not a name's %-sequence: as given
     const blob = new Blob(['x']);
     expect(await audioInput(blob)).toBe(blob);
   });
