@@ -25,12 +25,20 @@ def write_mesh_template(root):
     return root / "template" / "face.obj", root / "template" / "masks.json"
 
 
-def write_clip(root, key, frames, sr=16000, seconds=0.5):
+def face(mm_per_unit=1000.0, offset_mm=0.0):
+    """A neutral face 100 mm across in the layout's units (VOCASET's metres by default; Multiface: 1.0, millimetres)."""
+    grid = np.array([[i, j, 0] for j in range(3) for i in range(3)], np.float32)
+    return ((50.0 * grid + offset_mm) / mm_per_unit).astype(np.float32)
+
+
+def write_clip(root, key, frames, sr=16000, seconds=0.5, mm_per_unit=1000.0):
     (root / "wav").mkdir(exist_ok=True)
     (root / "vertices_npy").mkdir(exist_ok=True)
     t = np.arange(int(sr * seconds)) / sr
     write_wav(root / "wav" / f"{key}.wav", 0.3 * np.sin(2 * np.pi * 220 * t), sr)
-    verts = np.arange(frames * N * 3, dtype=np.float32).reshape(frames, N * 3)
+    # The face, every value a little apart (0.01 mm steps) so that frames can be told apart.
+    steps = np.arange(frames * N * 3, dtype=np.float32).reshape(frames, N * 3) * (0.01 / mm_per_unit)
+    verts = (face(mm_per_unit).reshape(1, N * 3) + steps).astype(np.float32)
     np.save(root / "vertices_npy" / f"{key}.npy", verts)
     return verts
 
@@ -44,7 +52,7 @@ def test_processed_vocaset(tmp_path):
     write_clip(tmp_path, f"{test}_sentence05", 30)   # test subjects use sentences 21-40 only
     write_clip(tmp_path, f"{test}_sentence21", 30)
     with open(tmp_path / "templates.pkl", "wb") as f:
-        pickle.dump({train: np.zeros((N, 3)), test: np.ones((N, 3))}, f, protocol=2)
+        pickle.dump({train: face(), test: face(offset_mm=1.0)}, f, protocol=2)
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
     assert ds.layout == "vocaset" and ds.fps == 30 and ds.mm_per_unit == 1000
     assert ds.keys("train") == [f"{train}_sentence01", f"{train}_sentence40"]
@@ -52,7 +60,7 @@ def test_processed_vocaset(tmp_path):
     clip = ds.load(f"{train}_sentence01")
     assert clip.subject == train and clip.num_frames == 15  # 60 -> 30 fps
     np.testing.assert_array_equal(clip.vertices.reshape(15, -1), raw[::2])
-    np.testing.assert_array_equal(ds.load(f"{test}_sentence21").template, np.ones((N, 3)))
+    np.testing.assert_array_equal(ds.load(f"{test}_sentence21").template, face(offset_mm=1.0))
     assert clip.pose is None and clip.phones is None
 
 
@@ -60,9 +68,9 @@ def test_processed_multiface(tmp_path):
     """FaceDiffuser's Multiface layout: 30 fps, subject_NN, sentences 1-40 / 41-45 / 46-50, millimetres."""
     mesh, masks = write_mesh_template(tmp_path)
     for k in (1, 41, 46, 50):
-        write_clip(tmp_path, f"6795937_{k:02d}", 12)
+        write_clip(tmp_path, f"6795937_{k:02d}", 12, mm_per_unit=1.0)
     with open(tmp_path / "templates.pkl", "wb") as f:
-        pickle.dump({"6795937": np.zeros((N, 3), dtype=np.float32)}, f)
+        pickle.dump({"6795937": face(1.0)}, f)
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
     assert ds.layout == "multiface" and ds.fps == 30
     assert ds.keys("train") == ["6795937_01"] and ds.keys("val") == ["6795937_41"]
@@ -76,11 +84,11 @@ def test_wrong_vertex_count_and_missing_pieces_are_reported(tmp_path):
     (tmp_path / "wav").mkdir()
     with pytest.raises(DatasetError, match="vertices_npy"):
         open_dataset(tmp_path, template=mesh, masks=masks)
-    write_clip(tmp_path, "S1_01", 4)
+    write_clip(tmp_path, "S1_01", 4, mm_per_unit=1.0)
     with pytest.raises(DatasetError, match="templates.pkl"):
         open_dataset(tmp_path, template=mesh, masks=masks)
     with open(tmp_path / "templates.pkl", "wb") as f:
-        pickle.dump({"S1": np.zeros((N, 3))}, f)
+        pickle.dump({"S1": face(1.0)}, f)
     np.save(tmp_path / "vertices_npy" / "S1_01.npy", np.zeros((4, 7 * 3), dtype=np.float32))
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
     with pytest.raises(DatasetError, match="expected"):
@@ -93,9 +101,9 @@ def test_wrong_vertex_count_and_missing_pieces_are_reported(tmp_path):
 
 def test_a_clip_whose_audio_is_not_wav_is_reported_with_its_key(tmp_path):
     mesh, masks = write_mesh_template(tmp_path)
-    write_clip(tmp_path, "S1_01", 4)
+    write_clip(tmp_path, "S1_01", 4, mm_per_unit=1.0)
     with open(tmp_path / "templates.pkl", "wb") as f:
-        pickle.dump({"S1": np.zeros((N, 3))}, f)
+        pickle.dump({"S1": face(1.0)}, f)
     (tmp_path / "wav" / "S1_01.wav").write_bytes(b"not a wav at all")
     ds = open_dataset(tmp_path, template=mesh, masks=masks)
     with pytest.raises(DatasetError, match="clip S1_01: .* is not a WAV file"):
@@ -108,7 +116,7 @@ def own_dataset(root, keys, frames=30):
     for k in keys:
         write_clip(root, k, frames)
     with open(root / "templates.pkl", "wb") as f:
-        pickle.dump({k.split("_sentence")[0]: np.zeros((N, 3)) for k in keys}, f)
+        pickle.dump({k.split("_sentence")[0]: face() for k in keys}, f)
     return mesh, masks
 
 
@@ -170,6 +178,22 @@ def test_templates_pkl_faults_are_named(tmp_path):
         with pytest.raises(DatasetError, match=message):
             open_dataset(tmp_path, template=mesh, masks=masks)
     with open(tmp_path / "templates.pkl", "wb") as f:
-        pickle.dump({"bob": np.zeros((N, 3))}, f)
+        pickle.dump({"bob": face()}, f)
     with pytest.raises(DatasetError, match="templates.pkl has no neutral face for subject 'alice' \\(it has bob\\)"):
+        open_dataset(tmp_path, template=mesh, masks=masks).load("alice_sentence01")
+
+
+def test_data_in_other_units_than_the_layout_implies_is_refused(tmp_path):
+    """VOCASET-named data in millimetres (or a clip in other units than its neutral face) would train on nonsense."""
+    mesh, masks = own_dataset(tmp_path, ["alice_sentence01"])
+    (tmp_path / "splits.json").write_text(json.dumps({"train": ["alice_sentence01"]}))
+    open_dataset(tmp_path, template=mesh, masks=masks).load("alice_sentence01")  # metres, as VOCASET's: fine
+    with open(tmp_path / "templates.pkl", "wb") as f:
+        pickle.dump({"alice": face(1.0)}, f)  # millimetres
+    with pytest.raises(DatasetError, match=r"'alice'.s neutral face is 1e\+05 mm across if its values are in metres, as VOCASET"):
+        open_dataset(tmp_path, template=mesh, masks=masks)
+    with open(tmp_path / "templates.pkl", "wb") as f:
+        pickle.dump({"alice": face()}, f)
+    np.save(tmp_path / "vertices_npy" / "alice_sentence01.npy", np.tile(face(1.0).reshape(1, -1), (30, 1)))
+    with pytest.raises(DatasetError, match=r"clip alice_sentence01: its face is 1e\+03 times the size of subject 'alice'.s neutral face"):
         open_dataset(tmp_path, template=mesh, masks=masks).load("alice_sentence01")

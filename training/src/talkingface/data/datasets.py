@@ -126,6 +126,10 @@ class FaceDataset:
         if subject not in self.subject_templates:
             raise DatasetError(f"clip {key}: templates.pkl has no neutral face for subject {subject!r} "
                                f"(it has {', '.join(sorted(self.subject_templates)) or 'none'})")
+        ratio = _size_across(verts[:1], 1.0) / max(_size_across(self.subject_templates[subject], 1.0), 1e-12)
+        if not 0.5 <= ratio <= 2.0:  # data in another unit than its neutral face would train on nonsense
+            raise DatasetError(f"clip {key}: its face is {ratio:.3g} times the size of subject {subject!r}'s neutral face "
+                               f"in templates.pkl: both must be in {_units(self.mm_per_unit)}")
         clip = Clip(key, subject, audio, sr, self.fps, verts.reshape(-1, n, 3).astype(np.float32),
                     self.subject_templates[subject].reshape(n, 3).astype(np.float32))
         # Poses and alignments are optional for a dataset (VOCASET has neither), not for a clip of one that has them:
@@ -175,6 +179,7 @@ def open_dataset(root: str | Path, template: str | Path | None = None, masks: st
             splits[split] = [k for k in keys if k.split("_sentence")[0] in subs and int(k.split("_sentence")[1]) in sentences]
     else:
         splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
+    _check_sizes(root / "templates.pkl", subject_templates, 1000.0 if vocaset else 1.0, "VOCASET" if vocaset else "Multiface")
     if vocaset:  # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
         return FaceDataset(root, "vocaset", tpl, 30.0, 1000.0, splits, subject_templates, _frame_step=2)
     return FaceDataset(root, "multiface", tpl, 30.0, 1.0, splits, subject_templates)
@@ -206,6 +211,30 @@ def _open_corpus(root: Path) -> FaceDataset:
     splits = json.loads((root / "splits.json").read_text())
     mm = MM_PER_UNIT[meta["units"]]
     return FaceDataset(root, "corpus", tpl, float(meta["fps"]), mm, splits, _read_templates_pkl(root), meta)
+
+
+#: A neutral face's largest extent (mm) that the units are taken to be right for: a face alone is about 150 mm, a
+#: whole head with its neck under 600 (data in millimetres read as metres is a thousand times that).
+FACE_SIZE_MM = (50.0, 600.0)
+
+
+def _size_across(face: np.ndarray, mm_per_unit: float) -> float:
+    return float(np.ptp(np.asarray(face, dtype=np.float64).reshape(-1, 3), axis=0).max()) * mm_per_unit
+
+
+def _units(mm_per_unit: float) -> str:
+    return "metres" if mm_per_unit == 1000.0 else "millimetres"
+
+
+def _check_sizes(path: Path, faces: dict[str, np.ndarray], mm_per_unit: float, layout: str) -> None:
+    """Each subject's neutral face must be a face's size in the units its layout's names imply."""
+    for subject, face in faces.items():
+        size = _size_across(face, mm_per_unit)
+        if not FACE_SIZE_MM[0] <= size <= FACE_SIZE_MM[1]:
+            raise DatasetError(
+                f"{path}: subject {subject!r}'s neutral face is {size:.3g} mm across if its values are in "
+                f"{_units(mm_per_unit)}, as {layout}'s clip names imply (a face is about 150 mm): give templates.pkl "
+                f"and vertices_npy/ in {_units(mm_per_unit)}")
 
 
 def _real_template(root: Path, template: str | Path | None, masks: str | Path | None) -> Template:
