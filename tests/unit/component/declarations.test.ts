@@ -1,0 +1,39 @@
+/**
+ * The declarations the library ships (tsconfig.lib.json, emitted here into a temporary folder) compile in a strict
+ * TypeScript page that installed the package as npm would: its dependencies beside it, plus @types/three, the optional
+ * peer docs/embedding.md asks TypeScript users to add; skipLibCheck off, so every shipped .d.ts is checked.
+ */
+import { execFileSync } from 'node:child_process';
+import { cpSync, mkdirSync, mkdtempSync, symlinkSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { describe, expect, it } from 'vitest';
+
+const ROOT = resolve(import.meta.dirname, '../../..');
+const TSC = join(ROOT, 'node_modules/typescript/bin/tsc');
+
+describe('the shipped declarations', () => {
+  it('compile in a strict consumer project with three.js types installed', () => {
+    const dir = mkdtempSync(join(tmpdir(), 'consumer-'));
+    const pkg = join(dir, 'node_modules/talking-face');
+    execFileSync(process.execPath, [TSC, '-p', join(ROOT, 'tsconfig.lib.json'), '--outDir', join(pkg, 'dist/lib/types')], { cwd: ROOT });
+    cpSync(join(ROOT, 'package.json'), join(pkg, 'package.json'));
+    mkdirSync(join(dir, 'node_modules/@types'));
+    for (const dep of ['three', 'onnxruntime-web', '@types/three']) symlinkSync(join(ROOT, 'node_modules', dep), join(dir, 'node_modules', dep));
+    writeFileSync(join(dir, 'main.ts'), [
+      "import { TalkingFaceElement, type FrameDetail } from 'talking-face';",
+      "const face = document.createElement('talking-face') as TalkingFaceElement;",
+      "face.addEventListener('frame', (e) => console.log((e as CustomEvent<FrameDetail>).detail.frame));",
+    ].join('\n'));
+    writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
+      target: 'ES2022', module: 'ESNext', moduleResolution: 'bundler', strict: true, skipLibCheck: false, noEmit: true,
+      lib: ['ES2022', 'DOM', 'DOM.Iterable'], types: [] }, files: ['main.ts'] }));
+    let out = '';
+    try {
+      execFileSync(process.execPath, [TSC, '-p', dir], { cwd: dir, encoding: 'utf8' });
+    } catch (e) {
+      out = String((e as { stdout?: string }).stdout ?? e);
+    }
+    expect(out).toBe('');
+  }, 120_000);
+});
