@@ -19,6 +19,7 @@ import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
+import { measureLiveDisplay, printLiveDisplay, type LiveDisplay } from './live-display';
 import { envPort, portFree, positiveNumbers, readOptions, startServer, usageError } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
@@ -28,12 +29,15 @@ const USAGE = `npm run bench [-- OPTIONS]   the engine's speed and memory in hea
   --render-only            only the head's render benchmark, merged into the existing bench.json
   --first-load-only        the first load alone, and onnxruntime alone, printed; nothing written
   --first-load-url URL     with --first-load-only: of a page served elsewhere (e.g. an older build)
+  --live-only              the demo live (fake microphone) on a 1x and a 2x screen, printed; nothing written
+  --live-url URL           with --live-only: of a demo served elsewhere (e.g. an older build)
   --node-only              the Node part alone (Mel, CPU decoders), printed; nothing written
   --out FILE               write FILE instead of docs/results/bench.json (e.g. a reduced run's)
   BENCH_PORT=N             serve the build on port N (default 4191; it must be free)`;
 const o = readOptions('bench', USAGE, {
   seconds: { type: 'string', default: '10,60' }, backends: { type: 'string', default: 'cpu,webgpu' }, 'render-only': { type: 'boolean' },
-  'first-load-only': { type: 'boolean' }, 'first-load-url': { type: 'string' }, 'node-only': { type: 'boolean' }, out: { type: 'string' },
+  'first-load-only': { type: 'boolean' }, 'first-load-url': { type: 'string' }, 'node-only': { type: 'boolean' },
+  'live-only': { type: 'boolean' }, 'live-url': { type: 'string' }, out: { type: 'string' },
 });
 const OUT = resolve(ROOT, String(o.out ?? 'docs/results/bench.json'));
 if (!existsSync(dirname(OUT))) usageError('bench', USAGE, `--out ${o.out}: the folder ${dirname(OUT)} does not exist`);
@@ -45,7 +49,9 @@ const PORT = envPort('bench', USAGE, 'BENCH_PORT', 4191);
 const renderOnly = Boolean(o['render-only']);
 const firstLoadOnly = Boolean(o['first-load-only']);
 if (o['first-load-url'] && !firstLoadOnly) usageError('bench', USAGE, '--first-load-url goes with --first-load-only (another page\'s figures are not written into bench.json)');
-if (renderOnly && firstLoadOnly) usageError('bench', USAGE, '--render-only and --first-load-only each run one part: give one');
+const liveOnly = Boolean(o['live-only']);
+if (o['live-url'] && !liveOnly) usageError('bench', USAGE, '--live-url goes with --live-only (another page\'s figures are not written into bench.json)');
+if ([renderOnly, firstLoadOnly, liveOnly].filter(Boolean).length > 1) usageError('bench', USAGE, '--render-only, --first-load-only and --live-only each run one part: give one');
 
 /** The machine as the figures were taken: the load average says how busy it was (other work slows every figure here). */
 async function machineState(t0: number): Promise<Record<string, unknown>> {
@@ -94,7 +100,7 @@ async function nodeBench(): Promise<Record<string, number | string>> {
 }
 
 async function main(): Promise<void> {
-  const node = firstLoadOnly || renderOnly ? {} : await nodeBench();
+  const node = firstLoadOnly || renderOnly || liveOnly ? {} : await nodeBench();
   if (o['node-only']) {
     console.log(JSON.stringify(node, null, 1)); // a quick look; nothing written
     return;
@@ -104,6 +110,15 @@ async function main(): Promise<void> {
   const server = startServer('npx', ['vite', 'preview', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], ROOT);
   try {
     await server.ready(`http://127.0.0.1:${PORT}/dev/bench.html`);
+    // The demo live, as a visitor sees it: a separate browser with a fake microphone, at a 1x and a 2x screen.
+    const live: LiveDisplay[] = [];
+    if (!renderOnly && !firstLoadOnly) {
+      for (const scale of [1, 2]) live.push(await measureLiveDisplay(String(o['live-url'] ?? `http://127.0.0.1:${PORT}/`), SPEECH, scale));
+    }
+    if (liveOnly) {
+      printLiveDisplay(live);
+      return;
+    }
     const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: [...CHROMIUM_ARGS, '--enable-precise-memory-info'] });
     const firstLoad = renderOnly ? null : await measureFirstLoad(browser, String(o['first-load-url'] ?? `http://127.0.0.1:${PORT}/`), 5);
     // The floor under it: onnxruntime-web alone, started as the engine starts it (dev/ort-start.html).
@@ -136,6 +151,7 @@ async function main(): Promise<void> {
     }
     result.node = node;
     result.first_load = firstLoad;
+    result.live_display = live;
     result.machine = await machineState(t0);
     writeFileSync(OUT, JSON.stringify(result, null, 1) + '\n');
     print(result);
@@ -164,6 +180,7 @@ function print(r: Record<string, unknown>): void {
     `decoder ${f(nd.decoder_ms_per_frame, 2)} ms per frame in ${nd.decoder_kernel}, ${f(nd.decoder_latents_ms_per_frame, 2)} with its tokens made (TypeScript kernel: ${f(nd.decoder_js_ms_per_frame, 2)}; reference: ${f(nd.reference_decoder_ms_per_frame, 2)})`);
   printRender(r.render as Record<string, number>);
   printFirstLoad(r.first_load as FirstLoad);
+  printLiveDisplay(r.live_display as LiveDisplay[]);
   console.log('adapter:', JSON.stringify(r.adapter), `\nwritten: ${OUT}`);
 }
 

@@ -13,7 +13,7 @@ import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import { GltfAvatar } from './gltf-avatar';
 import { Blinks } from './blinks';
-import { softwareWebGL } from '../render/software-gl';
+import { pixelRatio, softwareWebGL } from '../render/software-gl';
 import { fetchBody, StalledError } from '../model/fetch-body';
 
 /** About a head's bounding radius in metres (glTF's unit). */
@@ -45,7 +45,7 @@ export class AvatarView {
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGL(), alpha: false }); // render/software-gl.ts
-    this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
+    this.renderer.setPixelRatio(pixelRatio());
     this.scene.background = new THREE.Color(0x1d2230);
     this.scene.add(avatar.gltf.scene);
     this.scene.add(new THREE.HemisphereLight(0xfff4ea, 0x39303a, 1.1));

@@ -20,7 +20,7 @@ import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
 import { pickFaceVertex, poseArrows } from './overlays';
-import { softwareWebGL } from './software-gl';
+import { pixelRatio, softwareWebGL } from './software-gl';
 
 export interface FaceViewOptions {
   /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
@@ -82,7 +82,7 @@ export class FaceView {
     options: FaceViewOptions = {},
   ) {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: options.antialias ?? !softwareWebGL(), alpha: false });
-    this.renderer.setPixelRatio(Math.min(globalThis.devicePixelRatio ?? 1, 2));
+    this.renderer.setPixelRatio(pixelRatio());
     this.model = new Head(template);
     shareTongueProgram(this.model);
     this.head = this.model.group;

@@ -35,3 +35,12 @@ function probe(): boolean {
   gl.getExtension('WEBGL_lose_context')?.loseContext();
   return isSoftwareRenderer(renderer);
 }
+
+/**
+ * The drawing buffer's pixels per CSS pixel: the screen's (at most 2) on a GPU; 1 where WebGL draws in software, where
+ * every pixel costs the CPU the model runs on: four times the pixels of a 2x screen left the live face a slideshow
+ * (`npm run bench -- --live-only`; README, the figures after the bench table).
+ */
+export function pixelRatio(): number {
+  return softwareWebGL() ? 1 : Math.min(globalThis.devicePixelRatio ?? 1, 2);
+}

@@ -1,6 +1,6 @@
 /** Software WebGL (src/render/software-gl.ts): which renderer names count as a software rasteriser. */
-import { describe, expect, it } from 'vitest';
-import { isSoftwareRenderer, softwareWebGL } from '../../../src/render/software-gl';
+import { afterEach, describe, expect, it, vi } from 'vitest';
+import { isSoftwareRenderer, pixelRatio, softwareWebGL } from '../../../src/render/software-gl';
 
 /** Renderer names as browsers report them (WEBGL_debug_renderer_info), and whether each is software. */
 const NAMES: [string, boolean][] = [
@@ -15,6 +15,8 @@ const NAMES: [string, boolean][] = [
   ['', false], // not named: a GPU is assumed
 ];
 
+afterEach(() => vi.unstubAllGlobals());
+
 describe('software WebGL', () => {
   it('names the software rasterisers, and leaves GPUs as hardware', () => {
     for (const [name, software] of NAMES) expect(isSoftwareRenderer(name), name).toBe(software);
@@ -22,5 +24,21 @@ describe('software WebGL', () => {
 
   it('assumes a GPU where there is no document to probe', () => {
     expect(softwareWebGL()).toBe(false);
+  });
+
+  it('draws at the screen\'s pixel ratio (at most 2) on a GPU, at 1 in software', async () => {
+    vi.stubGlobal('devicePixelRatio', 3);
+    expect(pixelRatio()).toBe(2);
+    vi.stubGlobal('devicePixelRatio', 1.5);
+    expect(pixelRatio()).toBe(1.5);
+    // A page whose WebGL names SwiftShader (the probe runs once per page: a fresh module).
+    const gl = { getExtension: (n: string) => (n === 'WEBGL_debug_renderer_info' ? { UNMASKED_RENDERER_WEBGL: 1 } : { loseContext() {} }),
+      getParameter: () => 'ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device (Subzero)), SwiftShader driver)' };
+    vi.stubGlobal('document', { createElement: () => ({ getContext: () => gl }) });
+    vi.resetModules();
+    const fresh = await import('../../../src/render/software-gl');
+    vi.stubGlobal('devicePixelRatio', 2);
+    expect(fresh.softwareWebGL()).toBe(true);
+    expect(fresh.pixelRatio()).toBe(1);
   });
 });
