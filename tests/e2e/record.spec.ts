@@ -35,7 +35,8 @@ test('record: the face follows the microphone live, then the take replays in syn
   await expect(page.locator('#clip-info')).toContainText('Recording');
   const frames = await page.evaluate(() => (globalThis as unknown as { talkingFace: { take: { animation: { frames: number } } } }).talkingFace.take.animation.frames);
   console.log(`live: the face showed ${shown} frames while ${frames} were made (a software-drawn face here draws ~15 a second)`);
-  expect(shown, 'live frames are played out, not only the last of each batch').toBeGreaterThan(frames / 4);
+  // Before, one frame per batch: 15 of 192 here; played out, 71 (the bound leaves room for a machine twice as busy).
+  expect(shown, 'live frames are played out, not only the last of each batch').toBeGreaterThan(frames / 6);
   const gaps = await lipGaps(page);
   expect(gaps.length).toBeGreaterThan(60);
   expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth opens and closes (mm)').toBeGreaterThan(2);
