@@ -101,8 +101,6 @@ export class Player {
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
   private liveQueue: { frames: Frames; f: number; due: number }[] = []; // live frames to show, each at its time
   private liveTick = 0; // the animation frame that shows them (0: none asked)
-  /** Live frames shown so far: those of a batch that came faster than the display shows frames pass unseen. */
-  liveShown = 0;
   private forgetGesture: () => void = () => undefined; // removes the listeners awaitGesture left on the document
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
@@ -184,7 +182,6 @@ export class Player {
       this.view.setSpeaking?.(this.liveQuiet < LIVE_REST_FRAMES);
       if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, f);
       this.pose(frames.pose.subarray(f * 6, f * 6 + 6));
-      this.liveShown++;
     }
     if (this.liveQueue.length) this.liveTick = requestAnimationFrame(this.showDue);
   };
