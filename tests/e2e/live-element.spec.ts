@@ -123,10 +123,11 @@ test('live frame events count the frames skipped to stay live, and a device that
   const before = (await skipped()).length;
   // A slow device: the page's thread held for 1.5 s (45 frames of speech), far beyond the live lag limit (15 frames).
   await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 1500); });
-  await expect.poll(async () => (await skipped()).length, { timeout: 10_000 }).toBeGreaterThan(before + 2);
+  await expect.poll(async () => (await skipped()).length, { timeout: 10_000 }).toBeGreaterThan(before + 3);
   await page.evaluate(() => (document.getElementById('left') as unknown as { stop(): void }).stop());
   const s = await skipped();
   expect(s.every((n, i) => Number.isInteger(n) && n >= (s[i - 1] ?? 0)), `a count that only grows: ${s}`).toBe(true);
-  // The first drain after the hold skips (one in flight across the hold may come first).
-  expect(Math.max(...s.slice(before, before + 2)) - s[before - 1], `frames skipped over the held 1.5 s: ${s}`).toBeGreaterThanOrEqual(20);
+  // A drain after the hold skips: one of the next three (on a loaded machine two may be in flight across the hold;
+  // a run in the whole suite saw 43, 43, 59, 118 around it: the hold's frames skipped at the third).
+  expect(Math.max(...s.slice(before, before + 3)) - s[before - 1], `frames skipped over the held 1.5 s: ${s}`).toBeGreaterThanOrEqual(20);
 });
