@@ -12,6 +12,9 @@ import { vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
  * examples/talkinghead.html (scripts/talkinghead-vendor.ts).
  */
 export default defineConfig({
+  // Relative: the library's workers (lib/assets/) are found beside talking-face.js wherever lib/ is deployed, not at
+  // the site's root /assets/ (where only the demo's build put copies of them).
+  base: './',
   publicDir: false,
   build: {
     outDir: 'dist/lib',

@@ -74,3 +74,16 @@ test('the demo served without sample clips offers only what there is', async ({ 
   await expect(page.locator('#sample-select')).toBeDisabled();
   await expect(page.locator('#sample-select')).toHaveAttribute('title', 'No sample clips: HTTP 404');
 });
+
+test('the library finds its workers beside itself (lib/assets/), not at the site root where only the demo has copies', async ({ page, context }) => {
+  test.setTimeout(60_000);
+  // Deployed as docs/embedding.md says: lib/, models/ and ort/, no /assets/ at the root.
+  await context.route((url) => url.pathname.startsWith('/assets/'), (r) => r.fulfill({ status: 404, body: 'not deployed' }));
+  await page.goto('/examples/embed.html');
+  const ready = await page.evaluate(() => (document.getElementById('left') as HTMLElement & { ready: Promise<{ backendReason: string }> })
+    .ready.then((engine) => engine.backendReason));
+  expect(ready).not.toMatch(/failed to load/);
+  const workers = page.workers().map((w) => new URL(w.url()).pathname);
+  expect(workers.some((p) => p.startsWith('/lib/assets/decoder-worker-')), workers.join(', ')).toBe(true);
+  expect(workers.some((p) => p.startsWith('/lib/assets/onnx-worker-')), workers.join(', ')).toBe(true);
+});
