@@ -2,6 +2,7 @@ import { defineConfig, defaultClientConditions, type Plugin } from 'vite';
 import { createReadStream, existsSync, statSync, cpSync, readFileSync } from 'node:fs';
 import { resolve, normalize, sep, extname } from 'node:path';
 import { ISOLATION_HEADERS, MIME, precompress, serveBuild } from './scripts/hosting.ts';
+import { captureWorkletFile } from './scripts/worklet-file.ts';
 
 /**
  * Cross-origin isolation (ISOLATION_HEADERS) lets onnxruntime-web use threads (SharedArrayBuffer).
@@ -87,7 +88,7 @@ export default defineConfig(({ mode }) => {
   const testPages = mode === 'test';
   const page = (name: string) => resolve(import.meta.dirname, name);
   return {
-    plugins: [modelsDir()],
+    plugins: [modelsDir(), captureWorkletFile()],
     server: { headers: ISOLATION_HEADERS, port: 5173, strictPort: false },
     preview: { headers: ISOLATION_HEADERS, port: 4173, strictPort: false },
     build: {

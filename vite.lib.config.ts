@@ -1,8 +1,9 @@
 import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { precompress } from './scripts/hosting.ts';
 import { vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
+import { precompress } from './scripts/hosting.ts';
+import { captureWorkletFile } from './scripts/worklet-file.ts';
 
 /**
  * The library build: dist/lib/talking-face.js (ES module) defines <talking-face> and exports the API
@@ -29,6 +30,7 @@ export default defineConfig({
     },
   },
   plugins: [
+    captureWorkletFile(),
     {
       name: 'talking-face-examples',
       closeBundle() {

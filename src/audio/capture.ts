@@ -4,18 +4,33 @@
  *
  * The AudioContext runs at the model's rate when the browser allows it (Chromium resamples the
  * stream for us); otherwise at the device's rate, and a streaming resampler brings the pieces down.
- * The worklet module is made from a string (a blob: URL), so the library needs no extra file and the
- * page makes no request for it.
+ * The worklet module (capture-worklet.js) is loaded from a blob: URL of its text, so the page makes no request for
+ * it; where a Content-Security-Policy refuses blob: scripts, from the library's own copy of the file.
  */
+import WORKLET from './capture-worklet.js?raw';
 
 export class MicrophoneError extends Error {
   override name = 'MicrophoneError';
+}
+
+/**
+ * Whether this document's permissions policy lets it use the microphone (Chromium's document.featurePolicy; true where
+ * the browser does not say): a frame without allow="microphone", or a sandboxed frame without an origin, would be
+ * refused by the browser before any person is asked, with "access was denied".
+ */
+function frameAllowsMicrophone(): boolean {
+  const policy = (globalThis.document as (Document & { featurePolicy?: { allowsFeature(f: string): boolean } }) | undefined)?.featurePolicy;
+  return policy?.allowsFeature('microphone') ?? true;
 }
 
 /** getUserMedia with messages a person can act on. */
 export async function openMicrophone(): Promise<MediaStream> {
   if (!globalThis.navigator?.mediaDevices?.getUserMedia) {
     throw new MicrophoneError('this page cannot use a microphone here (it needs a secure context: https or localhost)');
+  }
+  if (!frameAllowsMicrophone()) {
+    throw new MicrophoneError('this page is in a frame that is not allowed the microphone: the page that embeds it must give its <iframe> allow="microphone" ' +
+      '(and a sandboxed frame allow-same-origin as well); or open an audio file instead');
   }
   try {
     return await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
@@ -28,45 +43,6 @@ export async function openMicrophone(): Promise<MediaStream> {
   }
 }
 
-// Posts the mono mix of its input in blocks of `block` samples (128-sample render quanta gathered).
-const WORKLET = `
-class TalkingFaceCapture extends AudioWorkletProcessor {
-  constructor(options) {
-    super();
-    this.block = options.processorOptions.block;
-    this.buffer = new Float32Array(this.block);
-    this.filled = 0;
-    this.running = true;
-    // On 'stop': hand over the partial block, then say so; the main thread waits for 'stopped', so
-    // every captured sample reaches it even if it was busy and its message queue is long.
-    this.port.onmessage = (e) => {
-      if (e.data !== 'stop' || !this.running) return;
-      this.running = false;
-      if (this.filled > 0) this.port.postMessage(this.buffer.slice(0, this.filled));
-      this.port.postMessage('stopped');
-    };
-  }
-  process(inputs) {
-    if (!this.running) return false;
-    const input = inputs[0];
-    if (input && input.length > 0) {
-      const n = input[0].length;
-      for (let i = 0; i < n; i++) {
-        let s = 0;
-        for (let c = 0; c < input.length; c++) s += input[c][i];
-        this.buffer[this.filled++] = s / input.length;
-        if (this.filled === this.block) {
-          this.port.postMessage(this.buffer, [this.buffer.buffer]);
-          this.buffer = new Float32Array(this.block);
-          this.filled = 0;
-        }
-      }
-    }
-    return true;
-  }
-}
-registerProcessor('talking-face-capture', TalkingFaceCapture);
-`;
 
 /**
  * Linear-phase low-pass + fractional resampling, streaming: pieces in at `from` Hz, pieces out at
@@ -190,12 +166,7 @@ export class AudioCapture {
     }
     const rate = context.sampleRate;
     const block = Math.max(128, Math.round(((options.block ?? 256) * rate) / sampleRate));
-    const url = URL.createObjectURL(new Blob([WORKLET], { type: 'text/javascript' }));
-    try {
-      await context.audioWorklet.addModule(url);
-    } finally {
-      URL.revokeObjectURL(url);
-    }
+    await addCaptureModule(context);
     const node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
     const resampler = rate === sampleRate ? null : new StreamResampler(rate, sampleRate);
     const capture = { stopped: null as (() => void) | null };
@@ -290,5 +261,23 @@ export class AudioCapture {
     if (releaseStream) for (const t of this.stream.getTracks()) t.stop();
     // Deliberate: closing can only fail on a context that is already closed, which is the goal.
     await this.context.close().catch(() => undefined); // fails only on a context already closed: the goal
+  }
+}
+
+/** The worklet's file, beside this module's code in both builds (scripts/worklet-file.ts); not a literal, so Vite leaves it. */
+const WORKLET_FILE = 'capture-worklet.js';
+
+/** The worklet's module: a blob: URL of its text, else (a Content-Security-Policy without blob: in script-src) its file. */
+async function addCaptureModule(context: AudioContext): Promise<void> {
+  const url = URL.createObjectURL(new Blob([WORKLET], { type: 'text/javascript' }));
+  try {
+    await context.audioWorklet.addModule(url);
+  } catch (fromBlob) {
+    await context.audioWorklet.addModule(new URL(WORKLET_FILE, import.meta.url).href).catch((e: Error) => {
+      throw new Error(`the audio capture could not be loaded (${(fromBlob as Error).message}; from the library's files: ${e.message}): ` +
+        'a Content-Security-Policy must allow the page\'s own scripts (script-src \'self\')');
+    });
+  } finally {
+    URL.revokeObjectURL(url);
   }
 }

@@ -39,8 +39,6 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   // A group by default, so that a page may name the element (aria-label, which its canvas also takes).
   const internals = host.attachInternals?.();
   if (internals) internals.role = 'group';
-  const style = document.createElement('style');
-  style.textContent = STYLE;
   const canvas = newCanvas(host);
   const status = document.createElement('p');
   status.className = 'status';
@@ -52,6 +50,27 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   announcer.className = 'announce';
   announcer.setAttribute('role', 'status');
   announcer.setAttribute('aria-live', 'polite');
-  root.append(style, canvas, status, announcer);
+  root.append(canvas, status, announcer);
+  adoptStyle(root);
   return { canvas, status, announcer };
+}
+
+let sheet: CSSStyleSheet | null = null;
+
+/**
+ * The element's style as a constructed stylesheet, one for every instance: a page's Content-Security-Policy without
+ * 'unsafe-inline' in style-src blocks a <style> element, not this. A <style> where the browser cannot construct one.
+ */
+function adoptStyle(root: ShadowRoot): void {
+  if (typeof CSSStyleSheet !== 'undefined' && 'replaceSync' in CSSStyleSheet.prototype && 'adoptedStyleSheets' in root) {
+    if (!sheet) {
+      sheet = new CSSStyleSheet();
+      sheet.replaceSync(STYLE);
+    }
+    root.adoptedStyleSheets = [sheet];
+    return;
+  }
+  const style = document.createElement('style');
+  style.textContent = STYLE;
+  root.prepend(style);
 }

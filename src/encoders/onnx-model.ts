@@ -146,9 +146,12 @@ export class OnnxModel {
       return await WorkerRunner.create(worker, spec, provider);
     } catch (e) {
       if (!worker.failed && /no available backend/i.test((e as Error).message)) {
-        // The runtime itself (ort-wasm-*.wasm) did not load: a failed or damaged download. A later load tries anew.
-        const error = new ModelLoadError(`onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}) could not be loaded; ` +
-          `reload or try again (${(e as Error).message.split('\n')[0]})`);
+        // The runtime itself (ort-wasm-*.wasm) did not load: a failed or damaged download, or a page whose
+        // Content-Security-Policy forbids compiling WebAssembly (which no reload mends). A later load tries anew.
+        const why = (e as Error).message.split('\n')[0];
+        const error = new ModelLoadError(/unsafe-eval|Content Security Policy/i.test(why)
+          ? `the page's Content-Security-Policy does not let onnxruntime compile its WebAssembly: add 'wasm-unsafe-eval' to its script-src (${why})`
+          : `onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}) could not be loaded; reload or try again (${why})`);
         OrtWorker.discard(worker, error);
         throw error;
       }

@@ -88,3 +88,57 @@ test('in a right-to-left page with its own text styles, the status stays English
   await expect(page.locator('#left')).toBeHidden();
   expect(await page.locator('#left').evaluate((el) => el.getBoundingClientRect().height)).toBe(0);
 });
+
+/** The policy docs/embedding.md gives, as a page would send it, on a page whose only script is its own file. */
+const CSP = "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'";
+
+test('under the Content-Security-Policy docs/embedding.md gives, the element loads, speaks and follows the microphone', async ({ page, context }) => {
+  test.setTimeout(120_000);
+  await context.route('**/csp/page.html', (r) => r.fulfill({ contentType: 'text/html', headers: { 'Content-Security-Policy': CSP },
+    body: '<!doctype html><html lang="en"><title>CSP</title><body><talking-face id="face"></talking-face><script type="module" src="/csp/page.js"></script>' }));
+  await context.route('**/csp/page.js', (r) => r.fulfill({ contentType: 'text/javascript', headers: { 'Content-Security-Policy': CSP },
+    body: "globalThis.violations = [];\ndocument.addEventListener('securitypolicyviolation', (e) => globalThis.violations.push(`${e.violatedDirective} ${e.blockedURI}`));\nawait import('/lib/talking-face.js');" }));
+  await page.goto('/csp/page.html');
+  const face = page.locator('#face');
+  await expect(face.locator('p.status')).toContainText('Ready', { timeout: 60_000 });
+  expect(await face.evaluate((el) => el.getBoundingClientRect().height), 'its style applies (a <style> element would be refused)').toBeGreaterThan(200);
+  expect(await face.evaluate((el) => (el as FaceEl).speak('/examples/sample.wav').then(() => 'spoken', (e: Error) => e.message))).toBe('spoken');
+  await face.evaluate((el) => {
+    (globalThis as unknown as { live: number }).live = 0;
+    el.addEventListener('frame', (e) => ((e as CustomEvent).detail.mode === 'live' && (globalThis as unknown as { live: number }).live++));
+    return (el as FaceEl).startMicrophone();
+  });
+  await expect(face.locator('p.status')).toContainText('Listening', { timeout: 20_000 });
+  await expect.poll(() => page.evaluate(() => (globalThis as unknown as { live: number }).live), { timeout: 20_000 }).toBeGreaterThan(3);
+  await face.evaluate((el) => (el as FaceEl).stop());
+  expect(await page.evaluate(() => (globalThis as unknown as { violations: string[] }).violations)).toEqual([]);
+});
+
+test('in a frame not allowed the microphone, startMicrophone() says what the embedding page must add', async ({ page, context }) => {
+  test.setTimeout(60_000);
+  await context.route('**/frame/outer.html', (r) => r.fulfill({ contentType: 'text/html',
+    body: '<!doctype html><html lang="en"><title>outer</title><iframe src="/examples/embed.html" allow="microphone \'none\'" width="800" height="600"></iframe>' }));
+  await page.goto('/frame/outer.html');
+  const frame = page.frameLocator('iframe');
+  await expect(frame.locator('#left p.status')).toContainText('Ready', { timeout: 60_000 });
+  const message = await frame.locator('#left').evaluate((el) => (el as FaceEl).startMicrophone().then(() => 'started', (e: Error) => e.message));
+  expect(message).toMatch(/in a frame that is not allowed the microphone: the page that embeds it must give its <iframe> allow="microphone"/);
+});
+
+test('a policy without \'wasm-unsafe-eval\' on every response: the error says to add it', async ({ page, context, guard }) => {
+  test.setTimeout(90_000);
+  guard.allowConsoleError(/unsafe-eval|WebAssembly|wasm|Content Security Policy|Aborted|no available backend|could not be loaded/);
+  const strict = "default-src 'self'; script-src 'self'";
+  await context.route('**/csp/page.html', (r) => r.fulfill({ contentType: 'text/html', headers: { 'Content-Security-Policy': strict },
+    body: '<!doctype html><html lang="en"><title>CSP</title><body><talking-face id="face"></talking-face><script type="module" src="/csp/page.js"></script>' }));
+  await context.route('**/csp/page.js', (r) => r.fulfill({ contentType: 'text/javascript', headers: { 'Content-Security-Policy': strict },
+    body: "globalThis.errors = [];\ndocument.addEventListener('error', (e) => e.detail && globalThis.errors.push(e.detail.message), true);\nawait import('/lib/talking-face.js');" }));
+  // The workers' scripts carry the policy too, as from a server that sends it with every response.
+  await context.route('**/lib/assets/*.js', async (r) => {
+    const res = await r.fetch();
+    await r.fulfill({ response: res, headers: { ...res.headers(), 'content-security-policy': strict } });
+  });
+  await page.goto('/csp/page.html');
+  await expect.poll(() => page.evaluate(() => (globalThis as unknown as { errors: string[] }).errors), { timeout: 60_000 })
+    .toContainEqual(expect.stringMatching(/Content-Security-Policy does not let onnxruntime compile its WebAssembly: add 'wasm-unsafe-eval' to its script-src/));
+});
