@@ -243,7 +243,8 @@ export class TalkingFaceElement extends HTMLElement {
           return engine;
         },
         (e: Error) => {
-          if (this.hold === hold) [this.loading, this.hold, this.retrying] = [null, null, true]; // a later call retries
+          if (this.hold !== hold) throw e; // superseded (another model or backend): its failure is no longer the element's
+          [this.loading, this.hold, this.retrying] = [null, null, true]; // a later call retries
           throw this.fail('model', `the model could not be loaded: ${e.message}`);
         },
       );

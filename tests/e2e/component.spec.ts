@@ -142,3 +142,19 @@ test('a policy without \'wasm-unsafe-eval\' on every response: the error says to
   await expect.poll(() => page.evaluate(() => (globalThis as unknown as { errors: string[] }).errors), { timeout: 60_000 })
     .toContainEqual(expect.stringMatching(/Content-Security-Policy does not let onnxruntime compile its WebAssembly: add 'wasm-unsafe-eval' to its script-src/));
 });
+
+test('a model replaced while it loads reports nothing of its own failure; the new one is ready', async ({ page, guard }) => {
+  test.setTimeout(60_000);
+  guard.allowConsoleError(/404|Failed to load resource/);
+  await page.goto('/examples/embed.html');
+  const seen = await page.evaluate(() => new Promise<string[]>((resolve) => {
+    const got: string[] = [];
+    const el = document.createElement('talking-face');
+    el.setAttribute('model', '/models/no-such-manifest.json');
+    el.addEventListener('error', (e) => got.push(`error: ${(e as CustomEvent).detail.message}`));
+    el.addEventListener('ready', () => setTimeout(() => resolve([...got, 'ready']), 500));
+    document.body.append(el);
+    el.setAttribute('model', '/models/manifest.json'); // the page's script sets its own model at once
+  }));
+  expect(seen).toEqual(['ready']);
+});
