@@ -14,7 +14,7 @@ N = 9  # a 3x3 grid stands in for FLAME's 5023 vertices: nothing may depend on t
 
 def write_mesh_template(root):
     (root / "template").mkdir(parents=True)
-    verts = [f"v {i} {j} 0" for j in range(3) for i in range(3)]
+    verts = [f"v {0.05 * i} {0.05 * j} 0" for j in range(3) for i in range(3)]  # 100 mm across, in metres
     faces = []
     for j in range(2):
         for i in range(2):
@@ -197,3 +197,12 @@ def test_data_in_other_units_than_the_layout_implies_is_refused(tmp_path):
     np.save(tmp_path / "vertices_npy" / "alice_sentence01.npy", np.tile(face(1.0).reshape(1, -1), (30, 1)))
     with pytest.raises(DatasetError, match=r"clip alice_sentence01: its face is 1e\+03 times the size of subject 'alice'.s neutral face"):
         open_dataset(tmp_path, template=mesh, masks=masks).load("alice_sentence01")
+
+
+def test_a_template_in_other_units_than_it_says_is_refused(tmp_path):
+    """A mesh template in metres whose masks file says nothing of units (so millimetres): the face would be drawn tiny."""
+    mesh, masks = own_dataset(tmp_path, ["alice_sentence01"])
+    regions = json.loads(masks.read_text())["regions"]
+    masks.write_text(json.dumps({"regions": regions}))
+    with pytest.raises(DatasetError, match=r"the template face is 0\.1 mm across in the units it gives \(mm; .*\), the subjects' neutral faces 100 mm"):
+        open_dataset(tmp_path, template=mesh, masks=masks)

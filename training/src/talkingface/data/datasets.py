@@ -180,6 +180,7 @@ def open_dataset(root: str | Path, template: str | Path | None = None, masks: st
     else:
         splits = {split: [k for k in keys if int(k.rsplit("_", 1)[1]) in r] for split, r in MULTIFACE_SPLITS.items()}
     _check_sizes(root / "templates.pkl", subject_templates, 1000.0 if vocaset else 1.0, "VOCASET" if vocaset else "Multiface")
+    _check_template_units(tpl, subject_templates, 1000.0 if vocaset else 1.0)
     if vocaset:  # VOCASET is 60 fps; the community subsamples to 30 (FaceFormer data_loader: [::2]).
         return FaceDataset(root, "vocaset", tpl, 30.0, 1000.0, splits, subject_templates, _frame_step=2)
     return FaceDataset(root, "multiface", tpl, 30.0, 1.0, splits, subject_templates)
@@ -235,6 +236,18 @@ def _check_sizes(path: Path, faces: dict[str, np.ndarray], mm_per_unit: float, l
                 f"{path}: subject {subject!r}'s neutral face is {size:.3g} mm across if its values are in "
                 f"{_units(mm_per_unit)}, as {layout}'s clip names imply (a face is about 150 mm): give templates.pkl "
                 f"and vertices_npy/ in {_units(mm_per_unit)}")
+
+
+def _check_template_units(tpl: Template, faces: dict[str, np.ndarray], mm_per_unit: float) -> None:
+    """The template must be in the units it says (a mesh's masks file gives them): the browser draws it in them."""
+    sizes = sorted(_size_across(face, mm_per_unit) for face in faces.values())
+    if not sizes:
+        return
+    data, own = sizes[len(sizes) // 2], _size_across(tpl.vertices, tpl.to_millimetres())
+    if not 0.5 <= own / data <= 2.0:
+        raise DatasetError(
+            f"the template {tpl.id} is {own:.3g} mm across in the units it gives ({tpl.units}; a mesh's masks file says "
+            f"them as \"units\", mm when it does not), the subjects' neutral faces {data:.3g} mm: give the template's units")
 
 
 def _real_template(root: Path, template: str | Path | None, masks: str | Path | None) -> Template:
