@@ -10,6 +10,11 @@ export interface ReadyDetail {
   reason: string;
   vertices: number;
   model: string;
+  /**
+   * Threads the work runs on: onnxruntime's per session (1 where the page is not cross-origin isolated: docs/embedding.md,
+   * Build and host) and the CPU decoder's workers (1: in the page's thread).
+   */
+  threads: { encoders: number; decoder: number };
   /** With the `avatar` attribute: which naming scheme drives it, the names matched, the head bone. */
   avatar?: AvatarSummary;
 }

@@ -290,7 +290,7 @@ export class TalkingFaceElement extends HTMLElement {
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
       detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
-        avatar: this.avatar?.summary },
+        threads: { encoders: engine.encoderThreads, decoder: engine.cpuThreads }, avatar: this.avatar?.summary },
     }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.

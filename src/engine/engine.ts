@@ -27,6 +27,7 @@ import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
 import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from './checks';
+import { ortThreads } from '../encoders/ort-worker-client';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -108,6 +109,11 @@ export class TalkingFaceEngine {
   /** The decoder's weights (shared by the CPU and WebGPU decoders). */
   get decoderWeights(): DecoderWeights {
     return this.pipeline.decoders.weights;
+  }
+
+  /** onnxruntime's threads per session: 1 where the page is not cross-origin isolated (then it cannot start threads). */
+  get encoderThreads(): number {
+    return ortThreads();
   }
 
   /** CPU decoder threads: the workers' count, or 1 when decoding in the page's thread. */

@@ -158,3 +158,27 @@ test('a model replaced while it loads reports nothing of its own failure; the ne
   }));
   expect(seen).toEqual(['ready']);
 });
+
+test('ready says how many threads the work runs on: onnxruntime\'s only where the page is cross-origin isolated', async ({ page, context }) => {
+  test.setTimeout(90_000);
+  const threads = () => page.evaluate(() => new Promise<{ isolated: boolean; cores: number; threads: { encoders: number; decoder: number } }>((resolve) => {
+    const el = document.createElement('talking-face');
+    el.addEventListener('ready', (e) => resolve({ isolated: crossOriginIsolated, cores: navigator.hardwareConcurrency, threads: (e as CustomEvent).detail.threads }));
+    document.body.append(el);
+  }));
+  await page.goto('/examples/embed.html');
+  const isolated = await threads();
+  expect(isolated.isolated).toBe(true);
+  expect(isolated.threads.encoders).toBe(Math.min(4, isolated.cores));
+  expect(isolated.threads.decoder).toBeGreaterThanOrEqual(1);
+  // The same page without the isolation headers.
+  await context.route('**/examples/embed.html', async (r) => {
+    const res = await r.fetch();
+    const headers = Object.fromEntries(Object.entries(res.headers()).filter(([k]) => !/^cross-origin-(opener|embedder)-policy$/.test(k)));
+    await r.fulfill({ response: res, headers });
+  });
+  await page.goto('/examples/embed.html');
+  const plain = await threads();
+  expect(plain.isolated).toBe(false);
+  expect(plain.threads.encoders).toBe(1);
+});
