@@ -43,7 +43,6 @@ export async function openMicrophone(): Promise<MediaStream> {
   }
 }
 
-
 /**
  * Linear-phase low-pass + fractional resampling, streaming: pieces in at `from` Hz, pieces out at
  * `to` Hz, continuous across pieces. A windowed-sinc kernel (cut-off just under the lower Nyquist).
