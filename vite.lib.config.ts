@@ -1,8 +1,8 @@
 import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
 import { precompress } from './scripts/hosting.ts';
+import { vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
 import { captureWorkletFile } from './scripts/worklet-file.ts';
 
 /**

@@ -8,7 +8,8 @@ import { readFileSync } from 'node:fs';
 import { posix, resolve } from 'node:path';
 import type { Plugin } from 'vite';
 
-export const WORKLET_FILE = 'capture-worklet.js';
+/** The name capture.ts gives it (WORKLET_FILE there: src/ cannot import the build's scripts, nor they its ?raw import). */
+const WORKLET_FILE = 'capture-worklet.js';
 
 export function captureWorkletFile(): Plugin {
   return {

@@ -69,8 +69,6 @@ export function showStatus(text: string, isError = false): void {
   ui.status.classList.toggle('error', isError);
 }
 
-export { isolated } from './names'; // the messages' file names
-
 let announced = '';
 
 /** Tell screen readers of a change of state, once: the live region hears of ready, playing, recording, errors, never of progress. */

@@ -16,7 +16,8 @@ import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './s
 import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
 import { cancelExport, exportGlbFile, exportRawFile } from './export-ui';
-import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, isolated, type HeadChange } from './controls';
+import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, type HeadChange } from './controls';
+import { isolated } from './names';
 import { bindKeys } from './keyboard';
 import { innerLipGaps } from '../template/lip-gap';
 
@@ -319,8 +320,7 @@ bindControls({
 });
 
 bindDetailsPanel();
-// The view is null until the face is drawn.
-bindKeys({ escape, hasTake: () => take !== null, togglePlay, step: (delta) => showFrame(player.current + delta), view: () => view ?? null });
+bindKeys({ escape, hasTake: () => take !== null, togglePlay, step: (delta) => showFrame(player.current + delta), view: () => view ?? null }); // null until drawn
 for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
 
 start().catch((e: Error) => {

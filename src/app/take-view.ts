@@ -9,7 +9,8 @@ import type { TalkingFaceEngine, Animation, Backend } from '../engine/engine';
 import { LipTimeline, headDegrees } from './timeline';
 import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
-import { announce, headScaleText, showLegend, showStatus, tell, ui, isolated, type HeadChange } from './controls';
+import { announce, headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
+import { isolated } from './names';
 import { audioNotes } from '../player/player';
 import { raiseIfQuiet } from '../audio/decode';
 
