@@ -5,17 +5,20 @@
  * (issue 18, docs/results/README.md). Marks body[data-engine] as the demo does. Not part of the app.
  */
 import { fetchArtefacts } from '../src/model/artefacts';
-import { startOrt } from '../src/encoders/onnx-model';
+import { startOrt, type ExecutionProvider } from '../src/encoders/onnx-model';
 import { ContentEncoder } from '../src/encoders/content';
 import { PoseEncoder } from '../src/encoders/pose';
 
 async function main(): Promise<void> {
-  // As TalkingFaceEngine.load does without a hardware GPU, before any file has arrived; ?stallSeconds=N as load's option.
-  const stall = new URLSearchParams(location.search).get('stallSeconds');
-  startOrt(['wasm'], stall ? Number(stall) : undefined);
+  // As TalkingFaceEngine.load does without a hardware GPU, before any file has arrived; ?stallSeconds=N as load's
+  // option; ?providers=webgpu as it does on a hardware GPU (onnxruntime's WebGPU build, in the page).
+  const query = new URLSearchParams(location.search);
+  const stall = query.get('stallSeconds');
+  const providers: ExecutionProvider[] = query.get('providers') === 'webgpu' ? ['webgpu'] : ['wasm'];
+  startOrt(providers, stall ? Number(stall) : undefined);
   const { manifest, files, template } = await fetchArtefacts();
   void template.catch(() => undefined); // fetched as the engine fetches it, not needed here
-  await Promise.all([ContentEncoder.create(manifest, files, ['wasm']), PoseEncoder.create(manifest, files, ['wasm'])]);
+  await Promise.all([ContentEncoder.create(manifest, files, providers), PoseEncoder.create(manifest, files, providers)]);
   document.body.dataset.engine = 'ready';
 }
 

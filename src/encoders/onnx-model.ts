@@ -38,9 +38,8 @@ const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
 
 /**
  * onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker).
- * The plain build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker
- * (ort-runtime.ts). (The WebGPU build, used only on a hardware GPU, which no test here has, still fetches its own.) A failed
- * load is forgotten, so the next one tries again.
+ * Either build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker
+ * (ort-runtime.ts). A failed load is forgotten, so the next one tries again.
  */
 export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
   ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then(async (ort) => {
@@ -49,8 +48,7 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     ort.env.logLevel = 'error';
     const root = `${ortRoot()}${ort.env.versions.web}/`;
     ort.env.wasm.wasmPaths = root;
-    if (build === 'jsep') return ort;
-    ort.env.wasm.wasmBinary = await fetchRuntime(root, getRuntimeStallSeconds()).catch((e: Error) => {
+    ort.env.wasm.wasmBinary = await fetchRuntime(root, getRuntimeStallSeconds(), build).catch((e: Error) => {
       throw new ModelLoadError(`onnxruntime's runtime ${e.message}; reload or try again`);
     });
     return ort;

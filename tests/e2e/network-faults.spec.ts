@@ -54,12 +54,13 @@ test('a face whose WebGL context the browser takes says so, and again when it is
   await expect.poll(status, { timeout: 10_000 }).toBe('The face is drawn again.');
 });
 
-for (const where of ['its worker', 'the page (no Web Workers)'] as const) {
+for (const where of ['its worker', 'the page (no Web Workers)', 'the page (its WebGPU build)'] as const) {
   test(`onnxruntime's runtime download brings nothing, in ${where}: the load fails after stallSeconds, naming it, instead of loading forever`, async ({ page, context }) => {
     test.setTimeout(90_000);
-    if (where !== 'its worker') await page.addInitScript(() => Object.defineProperty(globalThis, 'Worker', { value: undefined }));
-    await context.route('**/ort/*/ort-wasm-simd-threaded.wasm', () => undefined); // never answered
-    await page.goto('/dev/ort-start.html?stallSeconds=2');
+    if (where === 'the page (no Web Workers)') await page.addInitScript(() => Object.defineProperty(globalThis, 'Worker', { value: undefined }));
+    const webgpu = where === 'the page (its WebGPU build)';
+    await context.route(`**/ort/*/ort-wasm-simd-threaded${webgpu ? '.jsep' : ''}.wasm`, () => undefined); // never answered
+    await page.goto(`/dev/ort-start.html?stallSeconds=2${webgpu ? '&providers=webgpu' : ''}`);
     await expect(page.locator('body')).toHaveAttribute('data-engine', 'error', { timeout: 45_000 });
     expect(await page.locator('body').getAttribute('data-error')).toMatch(/ort-wasm.*nothing arrived for 2 s/s);
   });
