@@ -9,6 +9,7 @@ import { tell, ui } from './controls';
 import { isolated } from './names';
 import { fmaModule, simdUnavailable } from '../attention/simd-kernel';
 import { SHORT_CLIP_SECONDS } from '../player/player';
+import { levels, SILENT_PEAK } from '../audio/decode';
 import type { Take } from './take-view';
 
 export function setupDetails(face: FaceTemplate, gpu: WebGPUSupport): string {
@@ -23,9 +24,12 @@ export function decoderDetails(e: TalkingFaceEngine): string {
   return `Decoder: ${e.backend} (${e.backendReason}; CPU decoder: ${kernel} on ${e.cpuThreads} thread${e.cpuThreads > 1 ? 's' : ''}).`;
 }
 
-/** A take's figures (no speed figure for a very short clip: its few frames measure start-up, not speed) and notes. */
+/**
+ * A take's figures (no speed figure for a very short clip: its few frames measure start-up, not speed; nor for a
+ * silent one, which the model is not run on: engine.animateSpeech) and notes.
+ */
 export function takeDetails(t: Take, notes: string[]): string {
-  const speed = t.seconds < SHORT_CLIP_SECONDS
+  const speed = levels(t.samples).peak < SILENT_PEAK ? 'not run on silent audio' : t.seconds < SHORT_CLIP_SECONDS
     ? 'no speed figure for a clip this short'
     : `${(t.computeMs / t.animation.frames).toFixed(1)} ms per frame, ${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time`;
   return `${isolated(t.name)}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');

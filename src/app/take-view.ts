@@ -162,7 +162,7 @@ export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSig
   showStatus(`Drawing the head's motion again${change.scale !== undefined ? ` at ${headScaleText(e.headMotionScale)}` : ''}…`);
   try {
     const t0 = performance.now();
-    const animation = await e.animate(t.samples, {
+    const { animation } = await e.animateSpeech(t.samples, { // (a take with no speech stays at rest)
       unposed: true,
       signal,
       onProgress: (done, total) => showStatus(`Drawing the head's motion again: frame ${done} of ${total}…`),
@@ -182,13 +182,12 @@ export async function animateAudio(e: TalkingFaceEngine, name: string, given: Fl
   const early = audioNotes(given, seconds, { raisedDb: gainDb, animating: true });
   e.resetTimes();
   const t0 = performance.now();
-  const animation = await e.animate(samples, {
+  const { animation, speech } = await e.animateSpeech(samples, {
     unposed: true,
     signal,
     onProgress: (done, total) => showStatus(`Animating ${isolated(name)}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
   });
   const computeMs = performance.now() - t0;
-  const speech = await e.restUnlessSpeech(animation);
   return { animation, computeMs, samples, notes: audioNotes(given, seconds, { speech, raisedDb: gainDb }) };
 }
 

@@ -1,9 +1,10 @@
 /**
  * Audio in: any file the browser can decode (wav, mp3, ogg/opus, webm, m4a where supported), a Blob,
- * or an AudioBuffer -> mono Float32Array at the model's sample rate. Mixing and resampling are done by
- * an OfflineAudioContext (down-mix to one channel, then the browser's resampler). Library code: Web Audio,
- * no DOM.
+ * or an AudioBuffer -> mono Float32Array at the model's sample rate. The channels are mixed here (mixToMono), the
+ * resampling is the browser's (an OfflineAudioContext). A file the browser cannot decode gets a reason from its
+ * first bytes where they tell one (sniff.ts). Library code: Web Audio, no DOM.
  */
+import { CONVERT, undecodableReason } from './sniff';
 
 export class AudioDecodeError extends Error {
   override name = 'AudioDecodeError';
@@ -45,22 +46,47 @@ async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: nu
     try {
       buffer = await ctx.decodeAudioData(bytes.slice(0));
     } catch (e) {
-      throw new AudioDecodeError(`this browser cannot decode the file (unsupported format or corrupt data): ${(e as Error).message || 'decode failed'}`);
+      throw new AudioDecodeError(undecodableReason(bytes)
+        ?? `this browser cannot decode the file (${(e as Error).message || 'decode failed'}): if it plays elsewhere, ${CONVERT}`);
     }
   }
   if (buffer.length === 0) throw new AudioDecodeError('the audio has no samples');
   const source = { decodedRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration };
-  if (buffer.numberOfChannels === 1 && buffer.sampleRate === sampleRate) {
-    return { samples: buffer.getChannelData(0).slice(), sampleRate, buffer, source };
+  const channels = Array.from({ length: buffer.numberOfChannels }, (_, c) => buffer.getChannelData(c));
+  if (buffer.sampleRate === sampleRate) return { samples: mixToMono(channels), sampleRate, buffer, source };
+  let mono = buffer; // resampled as it is where it has one channel (a long clip is not copied first)
+  if (channels.length > 1) {
+    mono = new AudioBuffer({ length: buffer.length, numberOfChannels: 1, sampleRate: buffer.sampleRate });
+    mono.copyToChannel(mixToMono(channels), 0);
   }
   const frames = Math.max(1, Math.round(buffer.duration * sampleRate));
   const offline = new OfflineAudioContext(1, frames, sampleRate);
   const node = offline.createBufferSource();
-  node.buffer = buffer;
-  node.connect(offline.destination); // one output channel: the browser down-mixes (speakers rule, (L + R) / 2)
+  node.buffer = mono;
+  node.connect(offline.destination);
   node.start();
   const rendered = await offline.startRendering();
   return { samples: rendered.getChannelData(0).slice(), sampleRate, buffer, source };
+}
+
+/** 5.1's channels (L, R, C, LFE, SL, SR) in Web Audio's down-mix to mono: the centre, the front pair, the surrounds. */
+const SURROUND_51 = [Math.SQRT1_2, Math.SQRT1_2, 1, 0, 0.5, 0.5];
+
+/**
+ * One channel (a new array) from a clip's: their mean, or for six channels (5.1) Web Audio's weights scaled to sum
+ * to one, so that speech on every channel keeps its level. (Web Audio's own down-mix sums 5.1 to 3.4 times a
+ * channel's level, which clips, and keeps only the first channel of counts with no speaker layout: 3, 5, 7 ...)
+ */
+export function mixToMono(channels: readonly Float32Array[]): Float32Array<ArrayBuffer> {
+  if (channels.length === 1) return new Float32Array(channels[0]);
+  const weights = channels.length === 6 ? SURROUND_51 : channels.map(() => 1);
+  const total = weights.reduce((a, b) => a + b, 0);
+  const out = new Float32Array(channels[0].length);
+  channels.forEach((x, c) => {
+    const g = weights[c] / total;
+    if (g) for (let i = 0; i < out.length; i++) out[i] += g * x[i];
+  });
+  return out;
 }
 
 /** Peak level and the share of samples at full scale, for warnings about silence and clipping. */

@@ -45,6 +45,14 @@ export interface TalkingFaceErrorDetail {
   stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar' | 'render';
 }
 
+/** What a failed speak() or startMicrophone() rejects with: the `error` event's message, and its stage. */
+export class TalkingFaceError extends Error {
+  override name = 'TalkingFaceError';
+  constructor(readonly stage: TalkingFaceErrorDetail['stage'], message: string) {
+    super(message);
+  }
+}
+
 /** The element's events by name (typed listeners: `face.addEventListener('ready', (e) => e.detail.backend)`). */
 export interface TalkingFaceEventMap extends Omit<HTMLElementEventMap, 'error'> {
   ready: CustomEvent<ReadyDetail>;

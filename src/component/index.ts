@@ -4,7 +4,7 @@ import type { TalkingFaceEventMap } from './events';
 
 export * from '../index';
 export { TalkingFaceElement, DEFAULT_MODEL, type ReadyDetail, type FrameDetail, type TalkingFaceErrorDetail } from './talking-face';
-export type { TalkingFaceEventMap } from './events';
+export { TalkingFaceError, type TalkingFaceEventMap } from './events';
 
 export function defineTalkingFace(name = 'talking-face'): void {
   if (!customElements.get(name)) customElements.define(name, name === 'talking-face' ? TalkingFaceElement : class extends TalkingFaceElement {});

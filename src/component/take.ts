@@ -41,14 +41,13 @@ export async function makeTake(engine: TalkingFaceEngine, audio: Blob | AudioBuf
   status('Animating…', true);
   let animation: Animation, computeMs: number, speech: boolean;
   try {
-    animation = await engine.animate(quiet.samples, {
+    ({ animation, speech } = await engine.animateSpeech(quiet.samples, { // silence, noise, music, a tone: the face at rest
       unposed: true,
       ...frameOptions(el),
       signal,
       onProgress: (done, total) => !signal.aborted && status(`Animating: frame ${done} of ${total}…`, false),
-    });
+    }));
     computeMs = performance.now() - t0;
-    speech = await engine.restUnlessSpeech(animation); // noise, music, a tone: the face at rest
   } catch (e) {
     throw new TakeError('inference', `animation failed: ${(e as Error).message}`);
   }

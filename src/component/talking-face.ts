@@ -20,7 +20,7 @@ import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { liveFrameDetail, playbackFrameDetail, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
+import { liveFrameDetail, playbackFrameDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
@@ -318,6 +318,6 @@ export class TalkingFaceElement extends HTMLElement {
     this.work = null; // failed: nothing left for stop() to cancel
     this.setStatus(message, true);
     this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
-    return new Error(message);
+    return new TalkingFaceError(stage, message);
   }
 }

@@ -26,6 +26,7 @@ import { StreamSession } from './stream';
 import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
+import { levels, SILENT_PEAK } from '../audio/decode';
 import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from './checks';
 import { ortThreads } from '../encoders/ort-worker-client';
 
@@ -262,9 +263,26 @@ export class TalkingFaceEngine {
   }
 
   /**
-   * Whether `animation` holds speech (hasSpeech); where it does not (noise, music, a tone, which the model would
-   * otherwise mouth as if it were speech), its face is held at rest first (holdRest). What the demo and
+   * A clip a person chose, to be shown: a silent one (peak below SILENT_PEAK) is the face at rest throughout, made
+   * without running the model (a long silent file is ready at once); any other is animate()'s,
+   * held at rest where no speech is found (restUnlessSpeech). `speech`: whether it held speech. What the demo and
    * <talking-face> do with every offline take.
+   */
+  async animateSpeech(samples: Float32Array, options: AnimateOptions = {}): Promise<{ animation: Animation; speech: boolean }> {
+    if (!options.onFrames && levels(checkedSamples(samples, 'animateSpeech')).peak < SILENT_PEAK) {
+      options.signal?.throwIfAborted();
+      const F = this.frameCount(samples.length);
+      const animation = await this.pipeline.restAnimation(F, options);
+      options.onProgress?.(F, F);
+      return { animation, speech: false };
+    }
+    const animation = await this.animate(samples, options);
+    return { animation, speech: await this.restUnlessSpeech(animation) };
+  }
+
+  /**
+   * Whether `animation` holds speech (hasSpeech); where it does not (noise, music, a tone, which the model would
+   * otherwise mouth as if it were speech), its face is held at rest first (holdRest).
    */
   async restUnlessSpeech(animation: Animation): Promise<boolean> {
     const speech = this.hasSpeech(animation);

@@ -15,14 +15,17 @@ import { poseFrames } from '../pose/posing';
 import type { HeadMotion, HeadMotionState } from '../pose/head-motion';
 import { levelAt } from '../encoders/voice-activity';
 import { MM_PER_UNIT, type FaceTemplate } from '../template/face-template';
-import type { Animation, Frames, StageTimes } from './frames';
-import { AvatarWeights } from '../avatar/weights';
+import { emptyBlendshapes, type Animation, type Frames, type StageTimes } from './frames';
+import { AvatarWeights, yawPitchRoll } from '../avatar/weights';
 import { ARKIT_NAMES } from '../avatar/names';
 import { LipClosure } from './lip-closure';
 import type { SolverState } from '../avatar/solver';
 
 /** Frames per chunk when the caller does not say: bounds memory and the WebGPU decoder's buffers. */
 export const DEFAULT_CHUNK_FRAMES = 96;
+
+/** Frames posed at a time by holdRest. */
+const HOLD_FRAMES = 256;
 
 /**
  * What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last
@@ -47,7 +50,7 @@ export class Pipeline {
   headScale = 1;
   private avatar: AvatarWeights | null = null;
   private restWeights: Promise<Float32Array> | null = null;
-  private rest: Promise<Float32Array> | null = null;
+  private rest: Promise<{ face: Float32Array; pose: Float32Array }> | null = null;
   private closure: LipClosure | null | undefined;
   private disposed = false;
 
@@ -121,16 +124,17 @@ export class Pipeline {
   }
 
   /**
-   * The face the model makes in silence (I + O in the template's units, the last frame of a second of silence, on a
-   * state of its own): what a face shows before and between speech. Computed once; the caller must not change it.
+   * The face the model makes in silence (I + O in the template's units) and its head pose (the mean pose, without
+   * the head's own motion): the last frame of a second of silence, on a state of its own. What a face shows before
+   * and between speech. Computed once; the caller must not change them.
    */
-  restFace(): Promise<Float32Array> {
+  restFrame(): Promise<{ face: Float32Array; pose: Float32Array }> {
     this.rest ??= (async () => {
       const silence = new Float32Array(this.manifest.audio.sample_rate);
       const F = this.frameCount(silence.length);
-      const frames = await this.produce(this.newState(), 0, F, silence, 0, silence.length);
+      const frames = await this.produce(this.newState({ headMotionScale: 0 }), 0, F, silence, 0, silence.length);
       const n3 = this.template.vertexCount * 3;
-      return frames.unposed.slice((F - 1) * n3, F * n3);
+      return { face: frames.unposed.slice((F - 1) * n3, F * n3), pose: frames.pose.slice((F - 1) * 6, F * 6) };
     })().catch((e: unknown) => {
       this.rest = null; // not kept: the next call tries again
       throw e;
@@ -138,18 +142,48 @@ export class Pipeline {
     return this.rest;
   }
 
+  restFace(): Promise<Float32Array> {
+    return this.restFrame().then((r) => r.face);
+  }
+
+  /**
+   * `frames` frames of the face at rest, the head still at the pose of silence (restFrame), made without running
+   * the model on them: what a silent clip is.
+   */
+  async restAnimation(frames: number, options: { keep?: boolean; unposed?: boolean; blendshapes?: boolean }): Promise<Animation> {
+    const n3 = this.template.vertexCount * 3;
+    const rest = await this.restFrame();
+    const pose = new Float32Array(frames * 6);
+    for (let f = 0; f < frames; f++) pose.set(rest.pose, f * 6);
+    const silence = Math.max(0, this.manifest.content_phones.indexOf('SIL'));
+    const animation: Animation = {
+      fps: this.fps, frames, pose, vertices: new Float32Array(options.keep ?? true ? frames * n3 : 0),
+      unposed: options.unposed ? new Float32Array(frames * n3) : undefined, phones: new Uint8Array(frames).fill(silence),
+      tongue: new Float32Array(frames), speech: new Float32Array(frames),
+      blendshapes: options.blendshapes ? emptyBlendshapes(frames) : undefined,
+    };
+    for (let f = 0; f < frames && animation.blendshapes; f++) yawPitchRoll(pose, f * 6, animation.blendshapes.headRotation, f * 3);
+    await this.holdRest(animation); // the face, and the blend shapes' weights and visemes
+    return animation;
+  }
+
   /**
    * The face at rest on every frame of `animation` (its head poses kept), in place; with blend shapes, the ARKit
-   * weights of the rest (restArkit) and the visemes at viseme_sil.
+   * weights of the rest (restArkit) and the visemes at viseme_sil. Posed a few hundred frames at a time: an hour's
+   * clip needs no copy of its frames.
    */
   async holdRest(animation: Animation): Promise<void> {
     const rest = this.offsetsOf(await this.restFace());
     const n3 = rest.length;
-    const offsets = new Float32Array(animation.frames * n3);
-    for (let f = 0; f < animation.frames; f++) offsets.set(rest, f * n3);
-    const posed = poseFrames(this.templateMm, offsets, animation.pose, animation.frames, this.mmPerUnit);
-    if (animation.vertices.length) animation.vertices.set(posed.vertices);
-    animation.unposed?.set(posed.unposed);
+    const step = Math.min(HOLD_FRAMES, animation.frames);
+    const offsets = new Float32Array(step * n3);
+    for (let f = 0; f < step; f++) offsets.set(rest, f * n3);
+    for (let f0 = 0; f0 < animation.frames; f0 += step) {
+      const count = Math.min(step, animation.frames - f0);
+      const posed = poseFrames(this.templateMm, offsets.subarray(0, count * n3), animation.pose.subarray(f0 * 6, (f0 + count) * 6), count, this.mmPerUnit);
+      if (animation.vertices.length) animation.vertices.set(posed.vertices, f0 * n3);
+      animation.unposed?.set(posed.unposed, f0 * n3);
+    }
     animation.tongue.fill(0); // at rest, as in silence
     const b = animation.blendshapes;
     if (b) {

@@ -70,6 +70,37 @@ test('a missing model gives an error event and message, and the page keeps worki
   await expect.poll(() => page.locator('#left').evaluate((el) => (el as FaceEl).currentAnimation?.frames ?? 0), { timeout: 60_000 }).toBeGreaterThan(0);
 });
 
+test('speak() of a file the browser cannot decode rejects with a TalkingFaceError naming what it is; silence is the face at rest', async ({ page }) => {
+  test.setTimeout(60_000);
+  await page.goto('/examples/embed.html');
+  const outcome = await page.evaluate(async () => {
+    const el = document.getElementById('left') as HTMLElement & { speak(a: Blob): Promise<void>; stop(): void; currentAnimation: { frames: number } | null;
+      ready: Promise<{ times: Record<string, number>; restFace(): Promise<unknown> }> };
+    const header = new DataView(new ArrayBuffer(44 + 256));
+    [...'RIFF\0\0\0\0WAVEfmt '].forEach((c, i) => header.setUint8(i, c.charCodeAt(0)));
+    header.setUint32(16, 16, true);
+    header.setUint16(20, 0x11, true); // IMA ADPCM
+    header.setUint16(22, 1, true);
+    header.setUint32(24, 8000, true);
+    header.setUint16(34, 4, true);
+    [...'data'].forEach((c, i) => header.setUint8(36 + i, c.charCodeAt(0)));
+    header.setUint32(40, 256, true);
+    const failed = await el.speak(new Blob([header.buffer])).then(() => null, (e: Error & { stage?: string }) => ({ name: e.name, stage: e.stage, message: e.message }));
+    const engine = await el.ready;
+    await engine.restFace(); // the face at rest, which the model makes once from a second of silence
+    const modelMs = () => engine.times.content + engine.times.decoder;
+    const before = modelMs();
+    const played = el.speak(new AudioBuffer({ length: 16000 * 20, numberOfChannels: 1, sampleRate: 16000 }) as unknown as Blob);
+    await new Promise((r) => el.addEventListener('frame', r, { once: true }));
+    el.stop();
+    await played;
+    return { failed, modelMs: modelMs() - before, frames: el.currentAnimation?.frames, status: el.shadowRoot!.querySelector('p.status')!.textContent };
+  });
+  expect(outcome.failed).toEqual({ name: 'TalkingFaceError', stage: 'audio', message: expect.stringMatching(/WAV file in IMA ADPCM, which this browser cannot decode: convert it/) });
+  expect(outcome.frames).toBe(20 * 30);
+  expect(outcome.modelMs, 'the content encoder and the decoder did not run on 20 s of silence').toBe(0);
+});
+
 test('in a right-to-left page with its own text styles, the status stays English and readable; hidden hides it', async ({ page }) => {
   test.setTimeout(60_000);
   await page.goto('/examples/embed.html');

@@ -33,8 +33,45 @@ test.describe('odd audio', () => {
       console.log(`${name}: inner-lip gap at most ${Math.max(...gaps).toFixed(2)} mm over ${gaps.length} frames`);
       expect(Math.max(...gaps), 'largest inner-lip gap (mm)').toBeLessThan(1);
       expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth does not move (mm)').toBeLessThan(0.01);
+      // New head motion animates the clip again: the face stays at rest.
+      await page.evaluate(() => Object.assign(globalThis, { previousTake: (globalThis as unknown as { talkingFace: { take: unknown } }).talkingFace.take }));
+      await page.locator('#head-reroll').click();
+      await page.waitForFunction(() => {
+        const g = globalThis as unknown as { talkingFace: { take: unknown }; previousTake: unknown };
+        return g.talkingFace.take !== g.previousTake && document.body.dataset.take === 'ready';
+      }, null, { timeout: 60_000 });
+      const again = await lipGaps(page);
+      expect(Math.max(...again) - Math.min(...again), 'after New head motion, the mouth does not move (mm)').toBeLessThan(0.01);
     });
   }
+
+  test('speech on all six channels of a 5.1 file moves the mouth as the mono file does, with no clipping note', async ({ page }) => {
+    const { samples, rate } = speechSamples();
+    await page.locator('#file-input').setInputFiles({ name: 'mono.wav', mimeType: 'audio/wav', buffer: wav([samples], rate) });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    const mono = await lipGaps(page);
+    await page.locator('#file-input').setInputFiles({ name: 'surround.wav', mimeType: 'audio/wav', buffer: wav(new Array(6).fill(samples), rate) });
+    await expect(page.locator('#details')).toContainText('surround.wav', { timeout: 60_000 });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#details')).toContainText('6 channels mixed to mono');
+    await expect(page.locator('#details')).not.toContainText('clipped'); // Web Audio's own 5.1 down-mix made it 3.4 times as loud
+    const surround = await lipGaps(page);
+    expect(Math.max(...surround.map((g, i) => Math.abs(g - mono[i]))), 'inner-lip gap, 5.1 against mono (mm)').toBeLessThan(0.05);
+  });
+
+  test('a minute of silence is the face at rest at once: the model is not run on it', async ({ page }) => {
+    await page.locator('#file-input').setInputFiles({ name: 'silence.wav', mimeType: 'audio/wav', buffer: wav([new Float32Array(60 * SAMPLE_RATE)], SAMPLE_RATE) });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#status')).toContainText('the audio is silent');
+    await expect(page.locator('#details')).toContainText('not run on silent audio');
+    const times = await page.evaluate(() => (globalThis as unknown as { talkingFace: { engine: { times: Record<string, number> } } }).talkingFace.engine.times);
+    expect(times.content + times.decoder, 'the content encoder and the decoder did not run').toBe(0);
+    const gaps = await lipGaps(page);
+    expect(gaps.length).toBe(60 * 30);
+    expect(Math.max(...gaps) - Math.min(...gaps), 'the mouth does not move (mm)').toBeLessThan(0.01);
+    const pose = await page.evaluate(() => Array.from((globalThis as unknown as { talkingFace: { take: { animation: { pose: Float32Array } } } }).talkingFace.take.animation.pose));
+    expect(pose.every((x, i) => x === pose[i % 6]), 'the head still').toBe(true);
+  });
 
   test('quiet speech (peak -45 dBFS) is raised for the model and said so, and moves the mouth as speech', async ({ page }) => {
     const { samples, rate } = speechSamples();

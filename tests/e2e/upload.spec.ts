@@ -36,10 +36,12 @@ test.describe('animating an audio file', () => {
     expect((await lipGaps(page)).length).toBe(2 * FPS);
   });
 
-  test('a corrupt file gets a clear message and the page keeps working', async ({ page }) => {
-    await page.locator('#file-input').setInputFiles({ name: 'broken.wav', mimeType: 'audio/wav', buffer: Buffer.from('RIFF....WAVEnot really audio') });
+  test('a file that is not audio, or a damaged one, is named for what it is, and the page keeps working', async ({ page }) => {
+    await page.locator('#file-input').setInputFiles({ name: 'photo.png', mimeType: 'image/png', buffer: Buffer.from('\x89PNG\r\n\x1a\n and an image', 'latin1') });
     await expect(page.locator('body')).toHaveAttribute('data-take', 'error', { timeout: 30_000 });
-    await expect(page.locator('#status')).toContainText('cannot decode');
+    await expect(page.locator('#status')).toContainText('it is a PNG image, not audio');
+    await page.locator('#file-input').setInputFiles({ name: 'broken.wav', mimeType: 'audio/wav', buffer: Buffer.from('RIFF....WAVEnot really audio') });
+    await expect(page.locator('#status')).toContainText('it is a damaged WAV file');
     await page.locator('#file-input').setInputFiles(SPEECH);
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
   });
