@@ -158,20 +158,24 @@ export function bindControls(a: ControlActions): void {
   ui.playButton.addEventListener('click', () => a.togglePlay());
   ui.scrub.addEventListener('input', () => a.seek(Number(ui.scrub.value)));
   ui.backendSelect.addEventListener('change', () => a.setBackend(ui.backendSelect.value));
-  ui.stage.addEventListener('dragover', (e) => {
+  // Files dropped anywhere on the page (the browser would otherwise open a file dropped beside the face in place of
+  // the page); the face shows where it goes while files are dragged over the page.
+  let over = 0; // dragenter less dragleave: entering a child leaves its parent
+  const dragging = (on: boolean) => {
+    ui.stage.classList.toggle('dragging', on);
+    ui.dropHint.hidden = !on;
+  };
+  const files = (e: DragEvent) => e.dataTransfer?.types.includes('Files') ?? false;
+  document.addEventListener('dragenter', (e) => files(e) && dragging(++over > 0));
+  document.addEventListener('dragleave', (e) => files(e) && dragging(--over > 0));
+  document.addEventListener('dragover', (e) => files(e) && e.preventDefault());
+  document.addEventListener('drop', (e) => {
+    if (!files(e)) return;
     e.preventDefault();
-    ui.stage.classList.add('dragging');
-    ui.dropHint.hidden = false;
-  });
-  ui.stage.addEventListener('dragleave', () => {
-    ui.stage.classList.remove('dragging');
-    ui.dropHint.hidden = true;
-  });
-  ui.stage.addEventListener('drop', (e) => {
-    e.preventDefault();
-    ui.stage.classList.remove('dragging');
-    ui.dropHint.hidden = true;
-    const file = e.dataTransfer?.files?.[0];
+    over = 0;
+    dragging(false);
+    const all = [...(e.dataTransfer?.files ?? [])];
+    const file = all.find((f) => /^(audio|video)\//.test(f.type)) ?? all[0]; // of several, the first audio file
     a.unlockAudio();
     if (file) a.openFile(file);
   });

@@ -1,11 +1,18 @@
 /** A take's name as the demo shows it in a message and as the files it saves are named. */
 
+/** The most characters of a name a message shows: a longer one is cut in the middle (its end and extension kept). */
+export const SHOWN_NAME_LENGTH = 60;
+
 /**
- * A file's name inside a message, set apart (Unicode's first-strong isolate) where it holds right-to-left letters, so
+ * A file's name inside a message: at most SHOWN_NAME_LENGTH characters (a longer name would push the message's
+ * reason out of the status line), set apart (Unicode's first-strong isolate) where it holds right-to-left letters, so
  * that the words and numbers around it keep their order ("Saved تسجيل.97x468x3.f32" would show the 97 before the name).
  */
 export function isolated(name: string): string {
-  return /[\u0590-\u08ff\ufb1d-\ufdff\ufe70-\ufefc]/.test(name) ? `\u2068${name}\u2069` : name;
+  const chars = [...name];
+  const half = (SHOWN_NAME_LENGTH - 1) / 2;
+  const shown = chars.length <= SHOWN_NAME_LENGTH ? name : `${chars.slice(0, Math.ceil(half)).join('')}…${chars.slice(-Math.floor(half)).join('')}`;
+  return /[\u0590-\u08ff\ufb1d-\ufdff\ufe70-\ufefc]/.test(shown) ? `\u2068${shown}\u2069` : shown;
 }
 
 /**

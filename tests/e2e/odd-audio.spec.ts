@@ -108,4 +108,22 @@ test.describe('odd audio', () => {
     const gaps = await lipGaps(page);
     expect(Math.max(...gaps) - Math.min(...gaps), 'speech moves the mouth (mm)').toBeGreaterThan(2);
   });
+
+  test('files dropped on the controls, not the face, are taken too: of an image and a recording, the recording', async ({ page }) => {
+    const bytes = (await import('node:fs')).readFileSync(SPEECH).toString('base64');
+    const taken = await page.evaluate((b64) => {
+      const data = new DataTransfer();
+      data.items.add(new File([new Uint8Array([0x89, 0x50, 0x4e, 0x47])], 'cover.png', { type: 'image/png' }));
+      data.items.add(new File([Uint8Array.from(atob(b64), (c) => c.charCodeAt(0))], 'dropped-on-open.wav', { type: 'audio/wav' }));
+      const target = document.querySelector('.file-button')!;
+      target.dispatchEvent(new DragEvent('dragenter', { dataTransfer: data, bubbles: true, cancelable: true }));
+      const hint = !document.getElementById('drop-hint')!.hidden;
+      const over = !target.dispatchEvent(new DragEvent('dragover', { dataTransfer: data, bubbles: true, cancelable: true }));
+      const drop = !target.dispatchEvent(new DragEvent('drop', { dataTransfer: data, bubbles: true, cancelable: true }));
+      return { hint, over, drop, hintAfter: !document.getElementById('drop-hint')!.hidden };
+    }, bytes);
+    expect(taken, 'the drop hint shows while dragging; dragover and drop are taken (the browser does not open the file)').toEqual({ hint: true, over: true, drop: true, hintAfter: false });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#details')).toContainText('dropped-on-open.wav');
+  });
 });

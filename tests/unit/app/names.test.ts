@@ -8,6 +8,16 @@ describe('isolated', () => {
     expect(isolated('שלום.wav')).toBe('\u2068שלום.wav\u2069');
     expect(isolated('Grüße – 日本語.wav')).toBe('Grüße – 日本語.wav');
   });
+
+  it('cuts a name longer than 60 characters in the middle, keeping its end, by characters (not UTF-16 units)', () => {
+    const long = `${'a'.repeat(100)}_the_end.wav`;
+    expect(isolated(long)).toBe(`${'a'.repeat(30)}…${'a'.repeat(17)}_the_end.wav`);
+    expect([...isolated(long)]).toHaveLength(60);
+    expect(isolated('x'.repeat(60))).toBe('x'.repeat(60));
+    const emoji = '🎤'.repeat(70);
+    expect([...isolated(emoji)]).toHaveLength(60);
+    expect([...isolated(emoji)].every((c) => c === '🎤' || c === '…'), 'no character cut in half').toBe(true);
+  });
 });
 
 describe('fileBaseName', () => {
