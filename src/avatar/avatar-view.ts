@@ -7,7 +7,7 @@
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
-import { fitToCanvas } from '../render/canvas-size';
+import { fitToCanvas, OnScreen } from '../render/canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
@@ -27,6 +27,7 @@ export class AvatarView {
   readonly camera: THREE.PerspectiveCamera;
   readonly controls: OrbitControls;
   private readonly resizeObserver: ResizeObserver;
+  private readonly onScreen: OnScreen;
   private needsRender = true;
   private frameHandle = 0;
   private readonly blinks = new Blinks(performance.now());
@@ -78,6 +79,7 @@ export class AvatarView {
 
     this.resizeObserver = new ResizeObserver(() => this.resize());
     this.resizeObserver.observe(canvas);
+    this.onScreen = new OnScreen(canvas, () => this.requestRender());
     this.resize();
     this.loop();
   }
@@ -157,6 +159,7 @@ export class AvatarView {
   dispose(): void {
     cancelAnimationFrame(this.frameHandle);
     this.resizeObserver.disconnect();
+    this.onScreen.disconnect();
     this.controls.dispose();
     this.scene.traverse((o) => {
       const mesh = o as THREE.Mesh;
@@ -170,6 +173,7 @@ export class AvatarView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
+    if (!this.onScreen.shown) return;
     if (this.controls.update()) this.needsRender = true;
     if (this.speech !== this.target) this.ramp(performance.now() / 1000);
     const blink = this.avatar.canBlink && !this.reducedMotion?.matches ? this.blinks.at(performance.now()) : 0;

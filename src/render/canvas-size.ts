@@ -8,3 +8,25 @@ export function fitToCanvas(canvas: HTMLCanvasElement, renderer: THREE.WebGLRend
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
 }
+
+/**
+ * Whether any of a view's canvas is on screen (IntersectionObserver), for its frame loop: scrolled out of view or in a
+ * `display: none` container, a view draws nothing (the browser already stops a hidden tab's animation frames), and
+ * `onShown` asks for a frame when it comes back. True until the first report, so the first frame is not held up.
+ */
+export class OnScreen {
+  shown = true;
+  private readonly observer: IntersectionObserver;
+
+  constructor(canvas: HTMLCanvasElement, onShown: () => void) {
+    this.observer = new IntersectionObserver((entries) => {
+      this.shown = entries[entries.length - 1].isIntersecting;
+      if (this.shown) onShown();
+    });
+    this.observer.observe(canvas);
+  }
+
+  disconnect(): void {
+    this.observer.disconnect();
+  }
+}

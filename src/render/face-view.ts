@@ -3,19 +3,19 @@
  * eyes, teeth, tongue, a mouth) with three.js, and keeps it alive: between words it shows the model's rest face,
  * breathes, blinks and moves its eyes (idle-motion.ts); speech blends in and out of that rest without a pop.
  *
- * What is drawn each frame: shown = rest + s (frame - rest) + (1 - s) b B, where `frame` is the last face given to
- * setVertices, `rest` the model's rest face (setRestFace; the frame itself until one is given), s the speech weight
- * (ramped towards 1 by setSpeaking(true), towards 0 by setSpeaking(false)), b the idle blink and B the blink
- * field (eyelids.ts). The head pose is scaled by s the same way, so the head comes back to rest too.
+ * What is drawn each frame: shown = rest + s (frame - rest) + (1 - s + s o) b B, where `frame` is the last face given
+ * to setVertices, `rest` the model's rest face (setRestFace; the frame itself until one is given), s the speech weight
+ * (ramped towards 1 by setSpeaking(true), towards 0 by setSpeaking(false)), b the idle blink, B the blink field and
+ * o how open the frame's lids are against the rest's, 0 to 1 (eyelids.ts). The head pose is scaled by s the same way, so the head comes back to rest too.
  *
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
-import { fitToCanvas } from './canvas-size';
+import { fitToCanvas, OnScreen } from './canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { FaceTemplate } from '../template/face-template';
 import { Head } from './head';
-import { blinkField } from './eyelids';
+import { blinkField, lidOpening } from './eyelids';
 import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
@@ -67,6 +67,7 @@ export class FaceView {
   private tongue = 0;
   private readonly pose = new Float32Array(6);
   private readonly resizeObserver: ResizeObserver;
+  private readonly onScreen: OnScreen;
   private needsRender = true;
   private frameHandle = 0;
   private lastTime = -1;
@@ -116,6 +117,7 @@ export class FaceView {
 
     this.resizeObserver = new ResizeObserver(() => this.resize());
     this.resizeObserver.observe(canvas);
+    this.onScreen = new OnScreen(canvas, () => this.requestRender());
     this.resize();
     this.compose();
     // The first frame is drawn at the next animation frame, not here: what the caller starts meanwhile (the model's
@@ -260,6 +262,7 @@ export class FaceView {
   dispose(): void {
     cancelAnimationFrame(this.frameHandle);
     this.resizeObserver.disconnect();
+    this.onScreen.disconnect();
     this.controls.dispose();
     this.model.dispose();
     this.environment.dispose();
@@ -272,7 +275,9 @@ export class FaceView {
     const f = this.frame, out = this.shown;
     const rest = this.rest ?? f;
     const s = this.rest ? this.speech : 1;
-    const b = (this.idleState?.blink ?? 0) * (1 - s);
+    // The idle blink goes on during speech as far as the model's own lids are open (as an avatar's: gltf-avatar.ts).
+    const open = this.rest && s > 0 ? Math.min(1, Math.max(0, lidOpening(this.template, f) / (lidOpening(this.template, rest) || 1))) : 1;
+    const b = (this.idleState?.blink ?? 0) * (1 - s + s * open);
     for (let i = 0; i < out.length; i++) out[i] = rest[i] + s * (f[i] - rest[i]) + b * this.blink[i];
     this.model.setFace(out, this.tongue * s);
     this.requestRender();
@@ -294,6 +299,7 @@ export class FaceView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
+    if (!this.onScreen.shown) return; // (its life and camera catch up when it is shown again)
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
     if ((this.idle && this.alive) || this.idleState || this.speech !== this.speechTarget) this.update(performance.now() / 1000);
