@@ -1,6 +1,7 @@
 /**
  * A blink as a displacement of the face's vertices: what the idle face adds, times a weight from 0 (open) to
- * 1 (closed), to close its lids over the eyes while nobody speaks (during speech the model blinks by itself).
+ * 1 (closed), to close its lids over the eyes, at rest and during speech where the model's own lids are open
+ * (lidOpening: a model that blinks by itself is not closed twice).
  *
  * For each eye the upper lid's contour travels 80% of the way down to the lower contour below it and the lower
  * contour 20% up, so they meet; the skin within reach of a contour follows its nearest contour vertex, fading
@@ -57,4 +58,23 @@ export function blinkField(t: FaceTemplate): Float32Array {
     }
   }
   return d;
+}
+
+/**
+ * The eyes' opening in `positions` (the template's layout): the mean height of each upper-lid vertex above the lower
+ * lid's vertex nearest it across, both eyes, the corners left out. In the template's units.
+ */
+export function lidOpening(t: FaceTemplate, positions: Float32Array): number {
+  let sum = 0, n = 0;
+  for (const side of ['left', 'right'] as const) {
+    const up = t.regions[`eye_${side}_upper`], lo = t.regions[`eye_${side}_lower`];
+    for (const u of up) {
+      if (lo.includes(u)) continue; // a corner
+      let below = lo[0];
+      for (const l of lo) if (Math.abs(t.positions[3 * l] - t.positions[3 * u]) < Math.abs(t.positions[3 * below] - t.positions[3 * u])) below = l;
+      sum += positions[3 * u + 1] - positions[3 * below + 1];
+      n++;
+    }
+  }
+  return n ? sum / n : 0;
 }

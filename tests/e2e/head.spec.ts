@@ -46,6 +46,35 @@ test('at rest the face keeps its mouth closed, blinks and moves its eyes within 
   expect(seen.eyeTurn, 'the eyes moved (radians)').toBeGreaterThan((0.5 * Math.PI) / 180);
 });
 
+test('during speech the face blinks too, where the model\'s own lids stay open', async ({ page }) => {
+  test.setTimeout(120_000);
+  await animateFirstSample(page);
+  await page.locator('#loop-check').check();
+  if ((await page.locator('#play-button').textContent()) !== 'Pause') await page.locator('#play-button').click();
+  const seen = await page.evaluate(() => new Promise<{ openLid: number; minLid: number; speaking: number }>((resolve) => {
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
+    const r = tf.template.regions;
+    const only = (a: Uint32Array, b: Uint32Array) => Array.from(a).filter((v) => !b.includes(v));
+    const meanY = (p: Float32Array, vs: number[]) => vs.reduce((s, v) => s + p[3 * v + 1], 0) / vs.length;
+    const [lidUp, lidLo] = [only(r.eye_left_upper, r.eye_left_lower), only(r.eye_left_lower, r.eye_left_upper)];
+    const openLid = meanY(tf.template.positions, lidUp) - meanY(tf.template.positions, lidLo);
+    let minLid = Infinity, speaking = 0;
+    const t0 = performance.now();
+    const tick = () => {
+      if (tf.view.speechWeight > 0.99) {
+        minLid = Math.min(minLid, meanY(tf.view.shownVertices, lidUp) - meanY(tf.view.shownVertices, lidLo));
+        speaking++;
+      }
+      if (performance.now() - t0 < 8000) requestAnimationFrame(tick);
+      else resolve({ openLid, minLid, speaking });
+    };
+    requestAnimationFrame(tick);
+  }));
+  console.log(`speaking ${seen.speaking} frames: lids closed to ${(100 * seen.minLid / seen.openLid).toFixed(0)}% of open`);
+  expect(seen.speaking, 'frames drawn while speaking').toBeGreaterThan(10);
+  expect(seen.minLid / seen.openLid, 'a blink while speaking closes the lids').toBeLessThan(0.2);
+});
+
 /** The demo with its face at rest, then the first sample clip animated (a take ready). */
 async function animateFirstSample(page: Page): Promise<void> {
   await page.goto('/');
