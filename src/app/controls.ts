@@ -152,6 +152,12 @@ export function bindControls(a: ControlActions): void {
     ui.fileInput.value = '';
   });
   ui.recordButton.addEventListener('click', () => a.toggleRecording());
+  // The browser may take a view's WebGL context (a GPU reset, too many 3D views open) and give it back later
+  // (three.js then draws again): the page says so, instead of showing a blank face under its last message.
+  for (const canvas of [ui.canvas, ui.gtCanvas]) {
+    canvas.addEventListener('webglcontextlost', () => tell('The face can no longer be drawn: the browser took its WebGL context (a GPU reset, or too many 3D views open). It is drawn again when the browser gives it back; reloading the page brings it back too.', true));
+    canvas.addEventListener('webglcontextrestored', () => tell('The face is drawn again.'));
+  }
   // Opening or dropping a file is a gesture: the audio output is unlocked then, so the take can play once animated.
   ui.fileInput.addEventListener('click', () => a.unlockAudio());
   ui.cancelButton.addEventListener('click', () => a.cancel());

@@ -54,6 +54,20 @@ test('a face whose WebGL context the browser takes says so, and again when it is
   await expect.poll(status, { timeout: 10_000 }).toBe('The face is drawn again.');
 });
 
+test('the demo\'s face whose WebGL context the browser takes says so, and again when it is given back', async ({ page, guard }) => {
+  test.setTimeout(60_000);
+  guard.allowConsoleError(/WebGL|CONTEXT_LOST/);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-rest', 'shown', { timeout: 60_000 });
+  await page.evaluate(() => {
+    const ext = (document.getElementById('face-canvas') as HTMLCanvasElement).getContext('webgl2')!.getExtension('WEBGL_lose_context')!;
+    ext.loseContext();
+    setTimeout(() => ext.restoreContext(), 1000);
+  });
+  await expect(page.locator('#status')).toContainText('The face can no longer be drawn', { timeout: 5_000 });
+  await expect(page.locator('#status')).toHaveText('The face is drawn again.', { timeout: 10_000 });
+});
+
 for (const where of ['its worker', 'the page (no Web Workers)', 'the page (its WebGPU build)'] as const) {
   test(`onnxruntime's runtime download brings nothing, in ${where}: the load fails after stallSeconds, naming it, instead of loading forever`, async ({ page, context }) => {
     test.setTimeout(90_000);
