@@ -168,12 +168,16 @@ export function teethGeometry(f: MouthFrame, upper: boolean): THREE.BufferGeomet
   return arch(f, upper);
 }
 
-/** A tongue lying on the floor of the mouth behind the lower teeth, with its "raise" morph target. */
+/**
+ * A tongue lying on the floor of the mouth, its tip behind the lower incisors (their inner face is 0.2 to 0.23 W behind the
+ * lips' front: arch()), with its "raise" morph target, which lifts the front straight up behind the upper incisors
+ * (0.13 W) to the ridge above them, and a little back: never through the teeth.
+ */
 export function tongueGeometry(f: MouthFrame): THREE.BufferGeometry {
   const W = f.W;
   const g = new THREE.SphereGeometry(1, 28, 14);
-  g.scale(0.4 * W, 0.16 * W, 0.62 * W);
-  const cy = f.lowerY - 0.19 * W, cz = f.frontZ - 0.72 * W;
+  g.scale(0.4 * W, 0.16 * W, 0.56 * W);
+  const cy = f.lowerY - 0.19 * W, cz = f.frontZ - 0.8 * W; // the tip at 0.24 W behind the lips' front
   g.translate(f.center[0], cy, cz);
   const pos = g.getAttribute('position') as THREE.BufferAttribute;
   const raise = new Float32Array(pos.count * 3);
@@ -181,7 +185,7 @@ export function tongueGeometry(f: MouthFrame): THREE.BufferGeometry {
     const front = Math.min(1, Math.max(0, (pos.getZ(i) - (cz - 0.1 * W)) / (0.5 * W))); // 0 at the middle, 1 at the tip
     const w = front * front * (3 - 2 * front);
     raise[3 * i + 1] = w * (f.upperY - f.lowerY + 0.34 * W); // up to the ridge behind the upper teeth
-    raise[3 * i + 2] = w * 0.04 * W;
+    raise[3 * i + 2] = -w * 0.02 * W;
   }
   g.morphAttributes.position = [new THREE.BufferAttribute(raise, 3)];
   g.morphTargetsRelative = true;

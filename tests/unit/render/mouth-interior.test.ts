@@ -4,7 +4,7 @@
  */
 import { describe, expect, it } from 'vitest';
 import * as THREE from 'three';
-import { mouthBag, mouthFrame, tongueGeometry, updateBag } from '../../../src/render/mouth-interior';
+import { mouthBag, mouthFrame, teethGeometry, tongueGeometry, updateBag } from '../../../src/render/mouth-interior';
 import { jawHinge } from '../../../src/render/jaw';
 import { faceMeasures, ovalLoop } from '../../../src/render/head-shell';
 import { boundaryLoops } from '../../../src/template/mesh-topology';
@@ -42,10 +42,32 @@ describe('mouthBag', () => {
     const raise = g.morphAttributes.position![0] as THREE.BufferAttribute;
     let tip = 0, back = 0;
     for (let i = 0; i < pos.count; i++) {
-      if (pos.getZ(i) > f.frontZ - 0.2 * f.W) tip = Math.max(tip, raise.getY(i));
+      if (pos.getZ(i) > f.frontZ - 0.3 * f.W) tip = Math.max(tip, raise.getY(i));
       if (pos.getZ(i) < f.frontZ - 1.1 * f.W) back = Math.max(back, raise.getY(i));
     }
     expect(tip).toBeGreaterThan(0.5 * f.W * 0.5);
     expect(back).toBe(0);
+  });
+
+  it('the tongue stays behind the incisors: at rest behind the lower ones, raised behind the upper ones', async () => {
+    const t = await loadTemplateFile(loadManifest());
+    const f = mouthFrame(t);
+    const g = tongueGeometry(f);
+    const pos = g.getAttribute('position') as THREE.BufferAttribute;
+    const raise = g.morphAttributes.position![0] as THREE.BufferAttribute;
+    /** The inner (back) face of the central incisors: the least z of the teeth within 0.1 W of the midline. */
+    const innerFace = (upper: boolean) => {
+      const teeth = teethGeometry(f, upper).getAttribute('position') as THREE.BufferAttribute;
+      let z = Infinity;
+      for (let i = 0; i < teeth.count; i++) if (Math.abs(teeth.getX(i) - f.center[0]) < 0.1 * f.W) z = Math.min(z, teeth.getZ(i));
+      return z;
+    };
+    let rest = -Infinity, raised = -Infinity;
+    for (let i = 0; i < pos.count; i++) {
+      rest = Math.max(rest, pos.getZ(i));
+      raised = Math.max(raised, pos.getZ(i) + raise.getZ(i));
+    }
+    expect(rest, 'the tip at rest, against the lower incisors\' inner face').toBeLessThan(innerFace(false));
+    expect(raised, 'the tip raised, against the upper incisors\' inner face').toBeLessThan(innerFace(true));
   });
 });
