@@ -19,6 +19,8 @@ export class Eyes {
   readonly right: THREE.Group;
   /** Eye centres in the head's frame (template units). */
   readonly centers: THREE.Vector3[];
+  /** The balls' radii (template units). */
+  readonly radii: number[] = [];
 
   constructor(template: FaceTemplate) {
     const material = eyeMaterial();
@@ -43,6 +45,7 @@ export class Eyes {
       // The front of the ball sits just behind the deepest lid vertex, so lids close in front of it.
       eye.position.set(center.x, center.y - size.y * 0.08, box.max.z - radius * 1.02 - size.z * 0.12);
       this.centers.push(eye.position.clone());
+      this.radii.push(radius);
       groups.push(eye);
     }
     [this.left, this.right] = groups;

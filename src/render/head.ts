@@ -1,7 +1,8 @@
 /**
  * The whole head as three.js objects, built from a face template: one skin mesh whose vertex buffer is the face's
  * N vertices (what the model animates), then the head shell's (head-shell.ts), then the mouth cavity's
- * (mouth-interior.ts), drawn with two materials (skin; the inside of the mouth); the neck; the eyes (eyes.ts);
+ * (mouth-interior.ts), drawn with two materials (skin; the inside of the mouth); the neck; the eyes (eyes.ts) in
+ * dark sockets (the mouth's material);
  * upper teeth fixed to the skull; lower teeth and tongue on the jaw (jaw.ts). `group` is what the head pose moves.
  *
  * `setFace(face, tongue)` poses everything that follows the face for one frame of it: the jaw's angle is estimated
@@ -18,6 +19,9 @@ import { PartialNormals } from './normals';
 import { SKIN, cavityMaterial, clothMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
 
 const scratch = [0, 0];
+/** An eye socket's radius against its ball's, and how far round the ball it reaches from the back (radians). */
+const SOCKET = 1.12;
+const SOCKET_SPAN = 0.62 * Math.PI;
 
 export class Head {
   /** Moves with the head pose. */
@@ -101,6 +105,17 @@ export class Head {
     this.jaw.add(onJaw);
 
     this.eyes = new Eyes(t);
+    // Behind each eye a dark cup (the mouth's material: no shader program of its own), the back half of a sphere a
+    // little larger than the ball: the gaps between the lids and the ball show a socket, never the page behind.
+    const sockets = this.eyes.centers.map((c, k) => {
+      const cup = new THREE.Mesh(new THREE.SphereGeometry(SOCKET * this.eyes.radii[k], 24, 10, 0, 2 * Math.PI, 0, SOCKET_SPAN), this.skin.material[1]);
+      cup.geometry.rotateX(-Math.PI / 2); // its dome towards the back of the head (-z)
+      // Back a little, to keep its rim behind the temple's skin, and towards the nose, to reach behind the inner corner.
+      const r = this.eyes.radii[k];
+      cup.position.copy(c).add(new THREE.Vector3(Math.sign(m.centerX - c.x) * 0.2 * r, 0, -0.12 * r));
+      cup.name = `eye_socket_${k ? 'right' : 'left'}`;
+      return cup;
+    });
     const H = m.top - m.chin;
     const neck = new THREE.Mesh(new THREE.CylinderGeometry(0.66 * m.halfWidth, 0.74 * m.halfWidth, 0.72 * H, 28, 4, true), this.skin.material[0]);
     neck.name = 'neck';
@@ -109,7 +124,7 @@ export class Head {
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
-    this.group.add(this.skin, this.eyes.left, this.eyes.right, upper, this.jaw, neck);
+    this.group.add(this.skin, this.eyes.left, this.eyes.right, ...sockets, upper, this.jaw, neck);
 
     const body = new THREE.Mesh(new THREE.SphereGeometry(1, 48, 24, 0, Math.PI * 2, 0, Math.PI * 0.62), clothMaterial());
     body.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(body.geometry, WHITE), 3));
