@@ -102,44 +102,9 @@ test('an open vowel shows the inside of the mouth, with no background pixel insi
   await page.locator('#scrub').fill(String(open.frame));
   await expect.poll(() => page.evaluate(() => (globalThis as unknown as { talkingFace: TF }).talkingFace.view.speechWeight)).toBe(1);
   const png = (await page.locator('#face-canvas').screenshot()).toString('base64');
-  const result = await page.evaluate(async (b64) => {
-    type M4 = { elements: number[] };
-    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
-    const view = tf.view as unknown as { camera: { projectionMatrix: M4; matrixWorldInverse: M4 }; model: { bag: { rim: number[] }; skin: { matrixWorld: M4 } } };
-    const mul = (m: number[], v: number[]) => [0, 1, 2, 3].map((r) => m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * v[3]);
-    const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
-    const c = new OffscreenCanvas(bmp.width, bmp.height);
-    const ctx = c.getContext('2d')!;
-    ctx.drawImage(bmp, 0, 0);
-    const { data, width, height } = ctx.getImageData(0, 0, bmp.width, bmp.height);
-    const bg = [data[0], data[1], data[2]];
-    // The inner-lip loop on screen, shrunk 10% towards its centre (the lips' own anti-aliased edge stays out).
-    const p = tf.view.shownVertices;
-    const pts = view.model.bag.rim.map((v) => {
-      const world = mul(view.model.skin.matrixWorld.elements, [p[3 * v], p[3 * v + 1], p[3 * v + 2], 1]);
-      const clip = mul(view.camera.projectionMatrix.elements, mul(view.camera.matrixWorldInverse.elements, world));
-      return [((clip[0] / clip[3] + 1) / 2) * width, ((1 - clip[1] / clip[3]) / 2) * height];
-    });
-    const cx = pts.reduce((s, q) => s + q[0], 0) / pts.length, cy = pts.reduce((s, q) => s + q[1], 0) / pts.length;
-    const poly = pts.map(([x, y]) => [cx + 0.9 * (x - cx), cy + 0.9 * (y - cy)]);
-    const inside = (x: number, y: number) => {
-      let r = false;
-      for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
-        const [xi, yi] = poly[i], [xj, yj] = poly[j];
-        if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) r = !r;
-      }
-      return r;
-    };
-    let pixels = 0, background = 0;
-    for (let y = 0; y < height; y++)
-      for (let x = 0; x < width; x++) {
-        if (!inside(x + 0.5, y + 0.5)) continue;
-        pixels++;
-        const i = 4 * (y * width + x);
-        if (Math.abs(data[i] - bg[0]) + Math.abs(data[i + 1] - bg[1]) + Math.abs(data[i + 2] - bg[2]) <= 24) background++;
-      }
-    return { pixels, background };
-  }, png);
+  // The inner-lip loop, shrunk 10% towards its centre (the lips' own anti-aliased edge stays out).
+  const rim = await page.evaluate(() => (globalThis as unknown as { talkingFace: { view: { model: { bag: { rim: number[] } } } } }).talkingFace.view.model.bag.rim);
+  const result = await backgroundInside(page, png, [rim], 0.9);
   console.log(`open vowel (frame ${open.frame}, inner-lip gap ${open.gapMm.toFixed(1)} mm): ${result.pixels} pixels inside the lips, ${result.background} of them background`);
   await test.info().attach('open-vowel.png', { body: Buffer.from(png, 'base64'), contentType: 'image/png' });
   expect(result.pixels, 'the open mouth covers some pixels').toBeGreaterThan(40);
@@ -167,47 +132,12 @@ for (const [angle, az, el] of [['from three-quarters', 35, 0]] as const) {
     }, [az, el]);
     await page.waitForTimeout(1000);
     const png = (await page.locator('#face-canvas').screenshot()).toString('base64');
-    const result = await page.evaluate(async (b64) => {
-      type M4 = { elements: number[] };
-      const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
-      const view = tf.view as unknown as { camera: { projectionMatrix: M4; matrixWorldInverse: M4 }; model: { skin: { matrixWorld: M4 } } };
-      const mul = (m: number[], v: number[]) => [0, 1, 2, 3].map((r) => m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * v[3]);
-      const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
-      const c = new OffscreenCanvas(bmp.width, bmp.height);
-      const ctx = c.getContext('2d')!;
-      ctx.drawImage(bmp, 0, 0);
-      const { data, width, height } = ctx.getImageData(0, 0, bmp.width, bmp.height);
-      const bg = [data[0], data[1], data[2]];
-      const p = tf.view.shownVertices, r = tf.template.regions;
-      let pixels = 0, background = 0;
-      for (const side of ['left', 'right']) {
-        // The eye's opening on screen (its lid vertices in order round their centre; not shrunk: a gap between the lids
-        // and the ball lies along the lids).
-        const pts = [...new Set([...r[`eye_${side}_upper`], ...r[`eye_${side}_lower`]])].map((v) => {
-          const world = mul(view.model.skin.matrixWorld.elements, [p[3 * v], p[3 * v + 1], p[3 * v + 2], 1]);
-          const clip = mul(view.camera.projectionMatrix.elements, mul(view.camera.matrixWorldInverse.elements, world));
-          return [((clip[0] / clip[3] + 1) / 2) * width, ((1 - clip[1] / clip[3]) / 2) * height];
-        });
-        const cx = pts.reduce((s, q) => s + q[0], 0) / pts.length, cy = pts.reduce((s, q) => s + q[1], 0) / pts.length;
-        const poly = pts.sort((a, b) => Math.atan2(a[1] - cy, a[0] - cx) - Math.atan2(b[1] - cy, b[0] - cx));
-        const inside = (x: number, y: number) => {
-          let o = false;
-          for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
-            const [xi, yi] = poly[i], [xj, yj] = poly[j];
-            if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) o = !o;
-          }
-          return o;
-        };
-        for (let y = 0; y < height; y++)
-          for (let x = 0; x < width; x++) {
-            if (!inside(x + 0.5, y + 0.5)) continue;
-            pixels++;
-            const i = 4 * (y * width + x);
-            if (Math.abs(data[i] - bg[0]) + Math.abs(data[i + 1] - bg[1]) + Math.abs(data[i + 2] - bg[2]) <= 24) background++;
-          }
-      }
-      return { pixels, background };
-    }, png);
+    // Each eye's opening (its lid vertices; not shrunk: a gap between the lids and the ball lies along the lids).
+    const lids = await page.evaluate(() => {
+      const r = (globalThis as unknown as { talkingFace: TF }).talkingFace.template.regions;
+      return ['left', 'right'].map((side) => [...new Set([...r[`eye_${side}_upper`], ...r[`eye_${side}_lower`]])]);
+    });
+    const result = await backgroundInside(page, png, lids, 1);
     console.log(`eyes seen ${angle}: ${result.pixels} pixels inside the openings, ${result.background} of them background`);
     await test.info().attach(`eyes-${az}-${el}.png`, { body: Buffer.from(png, 'base64'), contentType: 'image/png' });
     expect(result.pixels, 'the eyes cover some pixels').toBeGreaterThan(40);
@@ -234,3 +164,50 @@ test('after speech the face blends back to its rest, mouth closed', async ({ pag
   });
   expect(gapMm, 'inner-lip gap after speech (mm)').toBeLessThan(1);
 });
+
+/**
+ * Pixels of a screenshot of the face canvas (`png`, base64) inside each loop of face vertices as drawn now (the
+ * vertices ordered round their centre, the polygon scaled by `shrink` towards it), and how many of them have the
+ * background's colour (the top-left pixel's).
+ */
+function backgroundInside(page: Page, png: string, loops: number[][], shrink: number): Promise<{ pixels: number; background: number }> {
+  return page.evaluate(async ([b64, loops, shrink]) => {
+    type M4 = { elements: number[] };
+    const tf = (globalThis as unknown as { talkingFace: TF }).talkingFace;
+    const view = tf.view as unknown as { camera: { projectionMatrix: M4; matrixWorldInverse: M4 }; model: { skin: { matrixWorld: M4 } } };
+    const mul = (m: number[], v: number[]) => [0, 1, 2, 3].map((r) => m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * v[3]);
+    const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+    const ctx = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d')!;
+    ctx.drawImage(bmp, 0, 0);
+    const { data, width, height } = ctx.getImageData(0, 0, bmp.width, bmp.height);
+    const bg = [data[0], data[1], data[2]];
+    const p = tf.view.shownVertices;
+    let pixels = 0, background = 0;
+    for (const loop of loops) {
+      const pts = loop.map((v) => {
+        const world = mul(view.model.skin.matrixWorld.elements, [p[3 * v], p[3 * v + 1], p[3 * v + 2], 1]);
+        const clip = mul(view.camera.projectionMatrix.elements, mul(view.camera.matrixWorldInverse.elements, world));
+        return [((clip[0] / clip[3] + 1) / 2) * width, ((1 - clip[1] / clip[3]) / 2) * height];
+      });
+      const cx = pts.reduce((s, q) => s + q[0], 0) / pts.length, cy = pts.reduce((s, q) => s + q[1], 0) / pts.length;
+      const poly = pts.sort((a, b) => Math.atan2(a[1] - cy, a[0] - cx) - Math.atan2(b[1] - cy, b[0] - cx))
+        .map(([x, y]) => [cx + shrink * (x - cx), cy + shrink * (y - cy)]);
+      const inside = (x: number, y: number) => {
+        let o = false;
+        for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
+          const [xi, yi] = poly[i], [xj, yj] = poly[j];
+          if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) o = !o;
+        }
+        return o;
+      };
+      for (let y = 0; y < height; y++)
+        for (let x = 0; x < width; x++) {
+          if (!inside(x + 0.5, y + 0.5)) continue;
+          pixels++;
+          const i = 4 * (y * width + x);
+          if (Math.abs(data[i] - bg[0]) + Math.abs(data[i + 1] - bg[1]) + Math.abs(data[i + 2] - bg[2]) <= 24) background++;
+        }
+    }
+    return { pixels, background };
+  }, [png, loops, shrink] as const);
+}
