@@ -181,7 +181,7 @@ export function bindControls(a: ControlActions): void {
     over = 0;
     dragging(false);
     const all = [...(e.dataTransfer?.files ?? [])];
-    const file = all.find((f) => /^(audio|video)\//.test(f.type)) ?? all[0]; // of several, the first audio file
+    const file = all.find((f) => /^(audio|video)\//.test(f.type)) ?? all[0]; // of several, the first audio (or video) file
     a.unlockAudio();
     if (file) a.openFile(file);
   });

@@ -6,7 +6,8 @@
  * What is drawn each frame: shown = rest + s (frame - rest) + (1 - s + s o) b B, where `frame` is the last face given
  * to setVertices, `rest` the model's rest face (setRestFace; the frame itself until one is given), s the speech weight
  * (ramped towards 1 by setSpeaking(true), towards 0 by setSpeaking(false)), b the idle blink, B the blink field and
- * o how open the frame's lids are against the rest's, 0 to 1 (eyelids.ts). The head pose is scaled by s the same way, so the head comes back to rest too.
+ * o how open the frame's lids are against the rest's, 0 to 1 (eyelids.ts). The head pose is scaled by s the same
+ * way, so the head comes back to rest too.
  *
  * The caller owns the canvas. Nothing is allocated per frame.
  */

@@ -105,8 +105,9 @@ export class Head {
     this.jaw.add(onJaw);
 
     this.eyes = new Eyes(t);
-    // Behind each eye a dark cup (the mouth's material: no shader program of its own), the back half of a sphere a
-    // little larger than the ball: the gaps between the lids and the ball show a socket, never the page behind.
+    // Behind each eye a dark cup (the mouth's material: no shader program of its own), a sphere a little larger than
+    // the ball from its back to a little in front of its middle: the gaps between the lids and the ball show a socket,
+    // not the page behind (from steeply below the page still shows above the ball; head.spec.ts).
     const sockets = this.eyes.centers.map((c, k) => {
       const cup = new THREE.Mesh(new THREE.SphereGeometry(SOCKET * this.eyes.radii[k], 24, 10, 0, 2 * Math.PI, 0, SOCKET_SPAN), this.skin.material[1]);
       cup.geometry.rotateX(-Math.PI / 2); // its dome towards the back of the head (-z)
