@@ -61,20 +61,27 @@ export function blinkField(t: FaceTemplate): Float32Array {
 }
 
 /**
- * The eyes' opening in `positions` (the template's layout): the mean height of each upper-lid vertex above the lower
- * lid's vertex nearest it across, both eyes, the corners left out. In the template's units.
+ * Each upper-lid vertex paired with the lower-lid vertex nearest it across (both eyes, the corners left out), as
+ * [upper, lower, upper, lower, ...]: what lidOpening measures.
  */
-export function lidOpening(t: FaceTemplate, positions: Float32Array): number {
-  let sum = 0, n = 0;
+export function lidPairs(t: FaceTemplate): Uint32Array {
+  const pairs: number[] = [];
+  const x = (v: number) => t.positions[3 * v];
   for (const side of ['left', 'right'] as const) {
     const up = t.regions[`eye_${side}_upper`], lo = t.regions[`eye_${side}_lower`];
     for (const u of up) {
       if (lo.includes(u)) continue; // a corner
       let below = lo[0];
-      for (const l of lo) if (Math.abs(t.positions[3 * l] - t.positions[3 * u]) < Math.abs(t.positions[3 * below] - t.positions[3 * u])) below = l;
-      sum += positions[3 * u + 1] - positions[3 * below + 1];
-      n++;
+      for (const l of lo) if (Math.abs(x(l) - x(u)) < Math.abs(x(below) - x(u))) below = l;
+      pairs.push(u, below);
     }
   }
-  return n ? sum / n : 0;
+  return Uint32Array.from(pairs);
+}
+
+/** The eyes' opening in `positions` (the template's layout): the mean height of the upper lid over the lower (lidPairs). */
+export function lidOpening(positions: Float32Array, pairs: Uint32Array): number {
+  let sum = 0;
+  for (let i = 0; i < pairs.length; i += 2) sum += positions[3 * pairs[i] + 1] - positions[3 * pairs[i + 1] + 1];
+  return pairs.length ? sum / (pairs.length / 2) : 0;
 }

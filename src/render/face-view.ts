@@ -16,7 +16,7 @@ import { fitToCanvas, OnScreen } from './canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { FaceTemplate } from '../template/face-template';
 import { Head } from './head';
-import { blinkField, lidOpening } from './eyelids';
+import { blinkField, lidOpening, lidPairs } from './eyelids';
 import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
@@ -59,6 +59,8 @@ export class FaceView {
   private lifePaused: boolean;
   private readonly reducedMotion = globalThis.matchMedia?.('(prefers-reduced-motion: reduce)') ?? null;
   private readonly blink: Float32Array;
+  private readonly lids: Uint32Array; // lidPairs; the rest face's opening, what a frame's lids are measured against:
+  private restOpening = 0;
   private readonly shown: Float32Array;
   private readonly frame: Float32Array;
   private rest: Float32Array | null = null;
@@ -93,6 +95,7 @@ export class FaceView {
     this.shown = new Float32Array(template.positions);
     this.frame = new Float32Array(template.positions);
     this.blink = blinkField(template);
+    this.lids = lidPairs(template);
     this.idle = options.life === false ? null : new IdleMotion(options.seed ?? 1);
     this.lifePaused = options.lifePaused ?? false;
     this.bodyHeight = this.model.body.scale.y;
@@ -169,6 +172,7 @@ export class FaceView {
   setRestFace(rest: Float32Array): void {
     if (rest.length !== this.frame.length) throw new Error(`setRestFace: expected ${this.frame.length / 3} vertices, got ${rest.length / 3}`);
     this.rest = rest.slice();
+    this.restOpening = lidOpening(this.rest, this.lids);
     if (!this.hasFrame) this.speech = this.speechTarget = 0;
     this.compose();
   }
@@ -277,7 +281,7 @@ export class FaceView {
     const rest = this.rest ?? f;
     const s = this.rest ? this.speech : 1;
     // The idle blink goes on during speech as far as the model's own lids are open (as an avatar's: gltf-avatar.ts).
-    const open = this.rest && s > 0 ? Math.min(1, Math.max(0, lidOpening(this.template, f) / (lidOpening(this.template, rest) || 1))) : 1;
+    const open = this.rest && s > 0 ? Math.min(1, Math.max(0, lidOpening(f, this.lids) / (this.restOpening || 1))) : 1;
     const b = (this.idleState?.blink ?? 0) * (1 - s + s * open);
     for (let i = 0; i < out.length; i++) out[i] = rest[i] + s * (f[i] - rest[i]) + b * this.blink[i];
     this.model.setFace(out, this.tongue * s);
