@@ -5,9 +5,9 @@
  * dark sockets (the mouth's material);
  * upper teeth fixed to the skull; lower teeth and tongue on the jaw (jaw.ts). `group` is what the head pose moves.
  *
- * `setFace(face, tongue)` poses everything that follows the face for one frame of it: the jaw's angle is estimated
- * from the face, the shell under the chin and the floor of the mouth follow it, normals are recomputed across
- * face, shell and cavity together. The view calls it each frame; the .glb export once per exported frame.
+ * `setFace(face, tongue)` poses everything that follows the face for one frame of it: the skin is kept outside the
+ * eyeballs (eyes.ts), the jaw's angle is estimated from the face, the shell under the chin and the floor of the
+ * mouth follow it, normals are recomputed across face, shell and cavity together. The view calls it each frame; the .glb export once per exported frame.
  */
 import * as THREE from 'three';
 import type { FaceTemplate } from '../template/face-template';
@@ -150,6 +150,7 @@ export class Head {
   setFace(face: ArrayLike<number>, tongue: number): void {
     const all = this.positions.array as Float32Array;
     for (let i = 0; i < this.n * 3; i++) all[i] = face[i];
+    this.eyes.clearance.apply(all); // the lids over the balls, not through them
     // The jaw may close past the template (the rest face) but the lower teeth stop at the upper ones.
     this.jawAngle = Math.max(-0.09, this.estimator.angle(face));
     const a = this.jawAngle;
