@@ -135,33 +135,58 @@ export function updateBag(bag: MouthBag, template: Float32Array, face: ArrayLike
   }
 }
 
-/** Place teeth along a parabolic arch: x from the midline out, z going back as x^2 (both in units of W). */
+/**
+ * Place teeth along a parabolic arch, z going back as x^2 (x from the midline, both in units of W), each crown
+ * centred at its arc length from the midline (the widths before it), so they stand side by side round the curve
+ * and the molars end about 0.6 W out and 0.7 W back, inside the cheeks (placed by x alone they reached 1 W out and
+ * 1.8 W back, with gaps between the side teeth). The biting edges follow a smooth line, the side teeth's a little
+ * further from the bite than the incisors' (a smile's arc).
+ */
 function arch(f: MouthFrame, upper: boolean): THREE.BufferGeometry {
   const W = f.W;
   // Crown widths of the central incisor, lateral incisor, canine, two premolars and a molar (W = 4.3 cm -> cm).
   const widths = [0.85, 0.68, 0.78, 0.7, 0.68, 0.95].map((w) => (w / 4.3) * W * (upper ? 1 : 0.82));
   const front = f.frontZ - 0.1 * W - (upper ? 0 : 0.075 * W);
-  const depthAt = (x: number) => 0.55 * (x / (0.55 * W)) ** 2 * W;
+  const curve = 1.82 / W; // depth = curve x^2
   const height = (upper ? 0.3 : 0.26) * W;
   const edge = upper ? f.upperY - 0.05 * W : f.lowerY - 0.03 * W;
+  const along = widths.reduce((t, w) => t + w, 0);
+  const xAt = arcToX(curve, along);
   const parts: THREE.BufferGeometry[] = [];
   for (const side of [-1, 1]) {
-    let x = 0;
+    let s = 0;
     widths.forEach((w, k) => {
-      const mid = x + w / 2;
-      x += w * 0.95;
-      const tooth = new RoundedBoxGeometry(w * 0.98, height * (k < 3 ? 1 : 0.8), (k < 2 ? 0.055 : 0.1 + 0.02 * k) * W, 2, w * 0.15);
-      const slope = (2 * 0.55 * mid) / (0.55 * W) ** 2 * W;
-      tooth.rotateY(-side * Math.atan(slope));
+      const mid = xAt(s + w / 2);
+      const rise = 0.03 * W * ((s + w / 2) / along) ** 2; // away from the bite
+      s += w;
+      const tall = height * (k < 3 ? 1 : 0.8);
+      const tooth = new RoundedBoxGeometry(w * 1.02, tall, (k < 2 ? 0.055 : 0.1 + 0.02 * k) * W, 2, w * 0.15);
+      tooth.rotateY(-side * Math.atan(2 * curve * mid));
       // Each crown hangs from (upper) or stands on (lower) the gum line, its biting edge at `edge`.
-      const y = upper ? edge + (height * (k < 3 ? 1 : 0.8)) / 2 + (k >= 3 ? 0.02 * W : 0) : edge - (height * (k < 3 ? 1 : 0.8)) / 2 - (k >= 3 ? 0.02 * W : 0);
-      tooth.translate(f.center[0] + side * mid, y, front - depthAt(mid));
+      const y = upper ? edge + tall / 2 + rise : edge - tall / 2 - rise;
+      tooth.translate(f.center[0] + side * mid, y, front - curve * mid * mid);
       parts.push(tooth);
     });
   }
   const merged = mergeGeometries(parts)!;
   for (const g of parts) g.dispose();
   return merged;
+}
+
+/** For the parabola z = curve x^2: x at arc length s from its vertex, for s up to `longest` (a table, linear between). */
+function arcToX(curve: number, longest: number): (s: number) => number {
+  const step = longest / 400;
+  const xs = [0], ss = [0];
+  while (ss[ss.length - 1] < longest) {
+    const x = xs[xs.length - 1];
+    xs.push(x + step);
+    ss.push(ss[ss.length - 1] + step * Math.hypot(1, 2 * curve * (x + step / 2)));
+  }
+  return (s) => {
+    let i = 1;
+    while (i < ss.length - 1 && ss[i] < s) i++;
+    return xs[i - 1] + ((s - ss[i - 1]) / (ss[i] - ss[i - 1])) * step;
+  };
 }
 
 export function teethGeometry(f: MouthFrame, upper: boolean): THREE.BufferGeometry {

@@ -70,4 +70,16 @@ describe('mouthBag', () => {
     expect(rest, 'the tip at rest, against the lower incisors\' inner face').toBeLessThan(innerFace(false));
     expect(raised, 'the tip raised, against the upper incisors\' inner face').toBeLessThan(innerFace(true));
   });
+
+  it('the teeth stand round an arch inside the cheeks: the molars about 0.6 W out and 0.7 W back', async () => {
+    const t = await loadTemplateFile(loadManifest());
+    const f = mouthFrame(t);
+    for (const upper of [true, false]) {
+      const box = new THREE.Box3().setFromBufferAttribute(teethGeometry(f, upper).getAttribute('position') as THREE.BufferAttribute);
+      // Placed by x alone (before), the arch reached 1.04 W out, beyond the mouth's corners, into the cheeks.
+      expect(Math.max(box.max.x - f.center[0], f.center[0] - box.min.x) / f.W).toBeGreaterThan(0.5);
+      expect(Math.max(box.max.x - f.center[0], f.center[0] - box.min.x) / f.W).toBeLessThan(0.75);
+      expect((f.frontZ - box.min.z) / f.W).toBeLessThan(1);
+    }
+  });
 });
