@@ -155,7 +155,7 @@ function animateFile(file: File): Promise<void> {
     showStatus(`Decoding ${isolated(file.name)}…`);
     const audio = await decodeAudio(file, e.manifest.audio.sample_rate, signal); // Cancel need not wait for a long decode
     const src = audio.source;
-    const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal);
+    const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal, src.statedSeconds);
     ui.clipInfo.textContent = `${isolated(file.name)}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
     return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
   });

@@ -175,11 +175,13 @@ export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSig
 
 /**
  * Animate decoded audio with progress in the status line (a quiet clip raised first: `samples` returns what was
- * animated, the take's); where no speech is found the face stays at rest.
+ * animated, the take's); where no speech is found the face stays at rest. `statedSeconds`: a file cut short's
+ * length as its header states it (DecodedAudio), for the notes.
  */
-export async function animateAudio(e: TalkingFaceEngine, name: string, given: Float32Array, seconds: number, signal: AbortSignal) {
+export async function animateAudio(e: TalkingFaceEngine, name: string, given: Float32Array, seconds: number, signal: AbortSignal,
+  statedSeconds: number | null = null) {
   const { samples, gainDb } = raiseIfQuiet(given);
-  const early = audioNotes(given, seconds, { raisedDb: gainDb, animating: true });
+  const early = audioNotes(given, seconds, { raisedDb: gainDb, animating: true, statedSeconds });
   e.resetTimes();
   const t0 = performance.now();
   const { animation, speech } = await e.animateSpeech(samples, {
@@ -188,7 +190,7 @@ export async function animateAudio(e: TalkingFaceEngine, name: string, given: Fl
     onProgress: (done, total) => showStatus(`Animating ${isolated(name)}: frame ${done} of ${total}…` + (early.length ? ` Note: ${early.join('; ')}.` : '')),
   });
   const computeMs = performance.now() - t0;
-  return { animation, computeMs, samples, notes: audioNotes(given, seconds, { speech, raisedDb: gainDb }) };
+  return { animation, computeMs, samples, notes: audioNotes(given, seconds, { speech, raisedDb: gainDb, statedSeconds }) };
 }
 
 /** The lips' outer outline, ordered by angle round its centre (seen from the front): where [ and ] go. */

@@ -4,7 +4,7 @@
  * resampling is the browser's (an OfflineAudioContext). A file the browser cannot decode gets a reason from its
  * first bytes where they tell one (sniff.ts). Library code: Web Audio, no DOM.
  */
-import { CONVERT, undecodableReason } from './sniff';
+import { CONVERT, statedSecondsIfCut, undecodableReason } from './sniff';
 
 export class AudioDecodeError extends Error {
   override name = 'AudioDecodeError';
@@ -16,8 +16,9 @@ export interface DecodedAudio {
   /** The decoded original, for playback at full quality. */
   buffer: AudioBuffer;
   /** What the input was, for messages: channels and duration (decodeAudioData resamples to its context's
-   * rate, so the file's own rate is not known here; decodedRate is that context rate). */
-  source: { decodedRate: number; channels: number; seconds: number };
+   * rate, so the file's own rate is not known here; decodedRate is that context rate); statedSeconds: where a
+   * WAV's header states more than the file holds (cut short), how long it says, else null. */
+  source: { decodedRate: number; channels: number; seconds: number; statedSeconds: number | null };
 }
 
 /**
@@ -37,9 +38,11 @@ export function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate:
 
 async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
   let buffer: AudioBuffer;
+  let statedSeconds: number | null = null;
   if (input instanceof AudioBuffer) buffer = input;
   else {
     const bytes = input instanceof Blob ? await input.arrayBuffer() : input;
+    statedSeconds = statedSecondsIfCut(bytes);
     if (bytes.byteLength === 0) throw new AudioDecodeError('the file is empty');
     // decodeAudioData needs a context; a one-sample offline context decodes without touching the speakers.
     const ctx = new OfflineAudioContext(1, 1, 44100);
@@ -51,7 +54,7 @@ async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: nu
     }
   }
   if (buffer.length === 0) throw new AudioDecodeError('the audio has no samples');
-  const source = { decodedRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration };
+  const source = { decodedRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration, statedSeconds };
   const channels = Array.from({ length: buffer.numberOfChannels }, (_, c) => buffer.getChannelData(c));
   if (buffer.sampleRate === sampleRate) return { samples: mixToMono(channels), sampleRate, buffer, source };
   let mono = buffer; // resampled as it is where it has one channel (a long clip is not copied first)

@@ -64,6 +64,29 @@ function wavReason(v: DataView): string {
   return `it is a WAV file (format ${tag}, ${bits}-bit) that this browser cannot decode: ${CONVERT}`;
 }
 
+/**
+ * How many seconds a WAV's header says its data chunk holds, where that is more than the file holds (a file cut
+ * short while copying or recording: browsers decode what is there and say nothing); null otherwise, and for other
+ * formats and for a data size left open (0 or 0xFFFFFFFF, as recorders that stream write it).
+ */
+export function statedSecondsIfCut(bytes: ArrayBuffer): number | null {
+  const v = new DataView(bytes);
+  if (v.byteLength < 12 || ascii(new Uint8Array(bytes, 0, 12), 0, 4) !== 'RIFF' || ascii(new Uint8Array(bytes, 0, 12), 8, 4) !== 'WAVE') return null;
+  let byteRate = 0;
+  for (let at = 12; at + 8 <= v.byteLength;) {
+    const id = ascii(new Uint8Array(bytes, at, 4), 0, 4);
+    const size = v.getUint32(at + 4, true);
+    if (id === 'fmt ' && at + 20 <= v.byteLength) byteRate = v.getUint32(at + 16, true);
+    if (id === 'data') {
+      const present = v.byteLength - at - 8;
+      if (size === 0 || size >= 0xffffff00 || size <= present || !byteRate) return null;
+      return size / byteRate;
+    }
+    at += 8 + size + (size % 2);
+  }
+  return null;
+}
+
 /** Printable text (UTF-8, tabs and line ends) throughout its first bytes. */
 function looksLikeText(b: Uint8Array): boolean {
   if (b.length === 0) return false;

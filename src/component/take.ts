@@ -52,7 +52,7 @@ export async function makeTake(engine: TalkingFaceEngine, audio: Blob | AudioBuf
     throw new TakeError('inference', `animation failed: ${(e as Error).message}`);
   }
   signal.throwIfAborted();
-  const notes = audioNotes(decoded.samples, seconds, { speech, raisedDb: quiet.gainDb });
+  const notes = audioNotes(decoded.samples, seconds, { speech, raisedDb: quiet.gainDb, statedSeconds: decoded.source.statedSeconds });
   const speed = seconds < SHORT_CLIP_SECONDS ? '' : `, ${(seconds / (computeMs / 1000)).toFixed(1)}x real time`;
   const playing = notes.length ? `Playing: ${notes.join('; ')}.` : `Playing (${animation.frames} frames${speed} on ${engine.backend}).`;
   return { decoded, animation, seconds, computeMs, playing };

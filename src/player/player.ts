@@ -37,15 +37,18 @@ export interface NoteOptions {
   raisedDb?: number;
   /** Notes while it is being animated: a long clip says it can be cancelled (default false). */
   animating?: boolean;
+  /** How long the file's header says it is, where it holds less (DecodedAudio's source.statedSeconds; default null). */
+  statedSeconds?: number | null;
 }
 
 /**
- * Notes for a person about a clip's audio, the most important first: silent, no speech in it, raised because it was
- * quiet, clipped, very short; long (while animating). Empty when there is nothing to say.
+ * Notes for a person about a clip's audio, the most important first: the file cut short, silent, no speech in it,
+ * raised because it was quiet, clipped, very short; long (while animating). Empty when there is nothing to say.
  */
-export function audioNotes(samples: Float32Array, seconds: number, { speech = true, raisedDb = 0, animating = false }: NoteOptions = {}): string[] {
+export function audioNotes(samples: Float32Array, seconds: number, { speech = true, raisedDb = 0, animating = false, statedSeconds = null }: NoteOptions = {}): string[] {
   const lv = levels(samples);
   const notes: string[] = [];
+  if (statedSeconds !== null && statedSeconds > seconds) notes.push(`the file ends early: it holds ${seconds.toFixed(1)} s of the ${statedSeconds.toFixed(1)} s its header states (cut short while copying or recording?)`);
   if (lv.peak < SILENT_PEAK) notes.push('the audio is silent, so the mouth stays closed');
   else if (!speech) notes.push('no speech was found in it (noise, music or a tone?), so the mouth stays at rest');
   if (lv.peak >= SILENT_PEAK && raisedDb > 0) notes.push(`very quiet (peak ${(20 * Math.log10(lv.peak)).toFixed(0)} dBFS): raised by ${raisedDb.toFixed(0)} dB to animate it`);

@@ -28,8 +28,7 @@ test.describe('animating an audio file', () => {
   });
 
   test('a silent recording is animated and reported as silent', async ({ page }) => {
-    // (That the mouth then stays closed is checked, and known to fail, in live-silence.spec.ts: the shipped
-    // model leaves the lips about 1.6 mm apart in silence; see docs/results/default.md.)
+    // (That the mouth stays closed through a silent microphone is checked in live-silence.spec.ts.)
     await page.locator('#file-input').setInputFiles({ name: 'silence.wav', mimeType: 'audio/wav', buffer: silentWav(2) });
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
     await expect(page.locator('#status')).toContainText('silent');
@@ -44,5 +43,12 @@ test.describe('animating an audio file', () => {
     await expect(page.locator('#status')).toContainText('it is a damaged WAV file');
     await page.locator('#file-input').setInputFiles(SPEECH);
     await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  });
+
+  test('a WAV cut short plays what it holds and says how much is missing', async ({ page }) => {
+    const whole = wav([Float32Array.from({ length: 2 * SAMPLE_RATE }, (_, i) => 0.3 * Math.sin(i / 5))], SAMPLE_RATE);
+    await page.locator('#file-input').setInputFiles({ name: 'cut.wav', mimeType: 'audio/wav', buffer: whole.subarray(0, 44 + SAMPLE_RATE) });
+    await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+    await expect(page.locator('#status')).toContainText('the file ends early: it holds 0.5 s of the 2.0 s its header states');
   });
 });

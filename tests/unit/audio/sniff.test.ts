@@ -1,9 +1,10 @@
 /**
  * undecodableReason (src/audio/sniff.ts): what a file the browser could not decode is, from its first bytes, on the
- * files people bring (as sox writes them: the WAVE header's format tag and sample size, the data chunk).
+ * files people bring (as sox writes them: the WAVE header's format tag and sample size, the data chunk); and
+ * statedSecondsIfCut: a WAV cut short, which the browser decodes without a word.
  */
 import { describe, expect, it } from 'vitest';
-import { undecodableReason } from '../../../src/audio/sniff';
+import { statedSecondsIfCut, undecodableReason } from '../../../src/audio/sniff';
 
 /** A RIFF/WAVE file: a fmt chunk with `tag` and `bits` (extensible: tag 0xFFFE carrying it as its sub-format), then `dataBytes` of data. */
 function wav(tag: number, bits: number, dataBytes: number, extensible = false): ArrayBuffer {
@@ -59,5 +60,28 @@ describe('undecodableReason', () => {
     expect(undecodableReason(new ArrayBuffer(64))).toBeNull();
     expect(undecodableReason(bytes(0x49, 0x44, 0x33, 0x04))).toBeNull(); // an MP3's ID3 tag: audio, damaged further on
     expect(undecodableReason(new ArrayBuffer(0))).toBeNull();
+  });
+});
+
+describe('statedSecondsIfCut', () => {
+  /** 16-bit mono PCM at 8 kHz (16,000 bytes a second) holding `present` bytes of data, its header stating `stated`. */
+  const pcm = (present: number, stated: number) => {
+    const b = wav(1, 16, present);
+    const v = new DataView(b);
+    v.setUint32(28, 16000, true); // byte rate
+    v.setUint32(40, stated, true); // the data chunk's size
+    return b;
+  };
+
+  it('says how long a WAV cut short claims to be', () => {
+    expect(statedSecondsIfCut(pcm(8000, 32000))).toBe(2);
+  });
+
+  it('says nothing of a whole WAV, an open size, or another format', () => {
+    expect(statedSecondsIfCut(pcm(8000, 8000))).toBeNull();
+    expect(statedSecondsIfCut(pcm(8000, 0))).toBeNull(); // a recorder streaming: size not yet written
+    expect(statedSecondsIfCut(pcm(8000, 0xffffffff))).toBeNull();
+    expect(statedSecondsIfCut(bytes(0x49, 0x44, 0x33, 0x04))).toBeNull();
+    expect(statedSecondsIfCut(new ArrayBuffer(4))).toBeNull();
   });
 });

@@ -198,6 +198,9 @@ describe('audioNotes', () => {
     // A long clip's note is for while it is animated (it says Cancel stops it), not for the take once shown.
     expect(audioNotes(speech, LONG_CLIP_SECONDS + 1, { animating: true }).join()).toMatch(/long clip/);
     expect(audioNotes(speech, LONG_CLIP_SECONDS + 1)).toEqual([]);
+    // A file cut short: how much of it there is, against what its header states.
+    expect(audioNotes(speech, 1, { statedSeconds: 4 })).toEqual(['the file ends early: it holds 1.0 s of the 4.0 s its header states (cut short while copying or recording?)']);
+    expect(audioNotes(speech, 1, { statedSeconds: null })).toEqual([]);
   });
 
   it('raises a quiet clip for the model and says by how much; leaves silence and ordinary levels alone', () => {
