@@ -15,6 +15,7 @@ import { headShell, faceMeasures, ovalLoop, type HeadShell, type FaceMeasures } 
 import { JawEstimator, jawHinge, turnAboutHinge, type Hinge } from './jaw';
 import { mouthBag, mouthFrame, teethGeometry, tongueGeometry, updateBag, type MouthBag } from './mouth-interior';
 import { Eyes } from './eyes';
+import { earGeometries } from './ears';
 import { PartialNormals } from './normals';
 import { SKIN, cavityMaterial, clothMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
 
@@ -125,7 +126,8 @@ export class Head {
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
-    this.group.add(this.skin, this.eyes.left, this.eyes.right, ...sockets, upper, this.jaw, neck);
+    const ears = this.shell ? earGeometries(m, this.shell.egg, SKIN).map((g, k) => Object.assign(new THREE.Mesh(g, this.skin.material[0]), { name: k ? 'ear_right' : 'ear_left' })) : [];
+    this.group.add(this.skin, this.eyes.left, this.eyes.right, ...sockets, ...ears, upper, this.jaw, neck);
 
     const body = new THREE.Mesh(new THREE.SphereGeometry(1, 48, 24, 0, Math.PI * 2, 0, Math.PI * 0.62), clothMaterial());
     body.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(body.geometry, WHITE), 3));
