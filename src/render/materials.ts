@@ -102,7 +102,9 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
       // The hairline: at the face's top in front, above the ears at the sides, down to the nape at the back.
       const back = Math.min(1, Math.max(0, -z / egg.back));
       const line = z > 0 ? egg.up * (0.1 + 0.4 * Math.min(1, z / (0.4 * egg.back))) : egg.up * (0.1 - 1.0 * back * back);
-      const h = Math.min(1, Math.max(0, (y - line) / (0.15 * egg.up)));
+      // A transition two or three of the shell's rings wide, eased: a sharper one shows their triangles as a sawtooth.
+      const f = Math.min(1, Math.max(0, (y - line) / (0.3 * egg.up) + 0.25));
+      const h = f * f * (3 - 2 * f);
       c.copy(SKIN).lerp(HAIR, h).toArray(colors, 3 * (n + i));
     }
   }
