@@ -26,6 +26,7 @@ export const ui = {
   gtCanvas: $<HTMLCanvasElement>('gt-canvas'),
   legend: $<HTMLParagraphElement>('legend'),
   exportGlbButton: $<HTMLButtonElement>('export-glb'),
+  exportVideoButton: $<HTMLButtonElement>('export-video'),
   exportRawButton: $<HTMLButtonElement>('export-raw'),
   headRerollButton: $<HTMLButtonElement>('head-reroll'),
   headScale: $<HTMLInputElement>('head-scale'),
@@ -49,7 +50,7 @@ export interface ControlsState { take: boolean; busy: boolean; headRedraw: boole
  */
 export function enableControls(s: ControlsState): void {
   const playable = s.take && !s.recording;
-  for (const b of [ui.playButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
+  for (const b of [ui.playButton, ui.exportVideoButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
   ui.headRerollButton.disabled = ui.headScale.disabled = !playable || !s.headMotion || (s.busy && !s.headRedraw);
   ui.recordButton.disabled = s.busy && !s.recording; // while a take is finished it keeps the focus (aria-disabled)
   // Cancel hides once the work ends: its focus goes to what comes next, not to the page's start.
@@ -118,6 +119,7 @@ export interface ControlActions {
   /** When painting one vertex's attention: a click on the face (client coordinates), or [ / ] (-1, 1) by keyboard. */
   pick(at: { x: number; y: number } | number): void;
   setBackend(choice: string): void;
+  exportVideo(): void;
   exportGlb(): void;
   exportRaw(): void;
   /** Draw the head's own motion again: with another seed, or scaled (1: as learnt). */
@@ -141,6 +143,7 @@ export function bindControls(a: ControlActions): void {
     ev.preventDefault();
     a.pick(ev.key === ']' ? 1 : -1);
   });
+  ui.exportVideoButton.addEventListener('click', () => a.exportVideo());
   ui.exportGlbButton.addEventListener('click', () => a.exportGlb());
   ui.exportRawButton.addEventListener('click', () => a.exportRaw());
   ui.headRerollButton.addEventListener('click', () => a.redrawHead({ nextSeed: true }));

@@ -1,11 +1,13 @@
-/** The demo's exports of a take: a .glb with morph-target animation, or the raw float32 frames. */
+/** The demo's exports of a take: a video of it playing, a .glb with morph-target animation, or the raw float32 frames. */
 import type { Animation } from '../engine/engine';
 import type { FaceTemplate } from '../template/face-template';
 import { exportGlb, rawFrames, download, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
 import { fileBaseName, isolated } from './names';
+import { recordTake, videoType } from './export-video';
+import type { Player } from '../player/player';
 
-/** The .glb being prepared (a long clip's takes seconds): Escape cancels it (cancelExport). */
+/** The .glb or video being prepared (a long clip's takes seconds, a video as long as the take): Escape cancels it (cancelExport). */
 let exporting: AbortController | null = null;
 
 /** Cancel a .glb being prepared; true if there was one. */
@@ -49,4 +51,32 @@ export function exportRawFile(animation: Animation, name: string, template: Face
   download(rawFrames(animation), file);
   tell(`Saved ${isolated(file)}: the raw frames.`);
   ui.exportInfo.textContent = (`Exported ${animation.frames} frames x ${n} vertices x 3 as float32 (little-endian, ${template.units}, ${animation.fps} fps).`);
+}
+
+/** Record the take playing, with its sound, and save it (export-video.ts); the button again or Escape cancels. */
+export async function exportVideoFile(player: Player, fps: number, name: string): Promise<void> {
+  if (exporting) {
+    if (ui.exportVideoButton.getAttribute('aria-busy')) exporting.abort(); // the button again: cancel
+    return;
+  }
+  const type = videoType();
+  if (!type) return tell('This browser cannot record video (it has no MediaRecorder for WebM or MP4): export a .glb instead.', true);
+  const controller = (exporting = new AbortController());
+  const frames = player.take?.frames ?? 0;
+  ui.exportVideoButton.setAttribute('aria-busy', 'true');
+  try {
+    const seconds = (frames / fps).toFixed(1);
+    const video = await recordTake(ui.canvas, player, fps, controller.signal,
+      (f) => showStatus(`Recording the video: ${(f / fps).toFixed(1)} of ${seconds} s… (Escape or Export video again cancels)`));
+    const file = `${fileBaseName(name)}.${type.startsWith('video/mp4') ? 'mp4' : 'webm'}`;
+    download(video, file);
+    tell(`Saved ${isolated(file)}: the take as a video with its sound.`);
+    ui.exportInfo.textContent = `Exported a ${seconds} s video (${type}, ${(video.size / 1e6).toFixed(1)} MB) of the face as shown, with the take's sound.`;
+  } catch (err) {
+    if (controller.signal.aborted) tell('Video cancelled.');
+    else tell(`The video could not be made: ${(err as Error).message}`, true);
+  } finally {
+    exporting = null;
+    ui.exportVideoButton.removeAttribute('aria-busy');
+  }
 }

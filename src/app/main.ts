@@ -15,7 +15,7 @@ import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
-import { cancelExport, exportGlbFile, exportRawFile } from './export-ui';
+import { cancelExport, exportGlbFile, exportRawFile, exportVideoFile } from './export-ui';
 import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls, type HeadChange } from './controls';
 import { isolated } from './names';
 import { bindKeys } from './keyboard';
@@ -24,9 +24,7 @@ import { innerLipGaps } from '../template/lip-gap';
 /** How long the face, once its template is in, waits for the model's files to reach onnxruntime (start()). */
 const FACE_WAITS_MS = 300;
 
-let view: FaceView;
-let player: Player;
-let takeView: TakeView;
+let view: FaceView, player: Player, takeView: TakeView;
 let engine: TalkingFaceEngine | null = null;
 let autoBackend: Backend = 'cpu';
 let take: Take | null = null;
@@ -314,6 +312,7 @@ bindControls({
   setSideBySide: (on) => { takeView.setSideBySide(on, take); publish(); if (take) player.show(player.current); },
   pick: (at) => takeView.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
+  exportVideo: () => take && void exportVideoFile(player, take.animation.fps, take.name),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
   redrawHead: redrawTakeHead,

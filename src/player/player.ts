@@ -99,6 +99,7 @@ export class Player {
   private buffer: AudioBuffer | null = null;
   private shape: ((frame: number, unposed: Float32Array) => Float32Array) | null = null;
   private context: AudioContext | null = null;
+  private tapNode: MediaStreamAudioDestinationNode | null = null; // where the sound also goes while tapped
   private playing: Playing | null = null;
   private currentFrame = 0;
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
@@ -215,6 +216,7 @@ export class Player {
       const source = context.createBufferSource();
       source.buffer = this.buffer;
       source.connect(context.destination);
+      if (this.tapNode) source.connect(this.tapNode);
       const startedAt = context.currentTime + 0.05;
       const playing: Playing = { source, startedAt, fromFrame: start, finish: resolve };
       source.onended = () => {
@@ -271,6 +273,18 @@ export class Player {
     this.context ??= new AudioContext();
     // Deliberate: resume() rejects only when the context is closed, and then play() throws with the reason.
     void this.context.resume().catch(() => undefined); // rejects only on a closed context; play() then says why
+  }
+
+  /** The sound of what plays from now on as a stream too (a recording of the take: app/export-video.ts), until untap(). */
+  tap(): MediaStream {
+    this.context ??= new AudioContext();
+    this.tapNode ??= this.context.createMediaStreamDestination();
+    return this.tapNode.stream;
+  }
+
+  untap(): void {
+    this.tapNode?.disconnect();
+    this.tapNode = null;
   }
 
   /** Stop playback (the face keeps the frame it shows). */

@@ -10,7 +10,7 @@ import { SPEECH, speechSamples, wav } from './helpers/audio';
 test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
 const WATCHED = ['#face-canvas', '#timeline', '#file-input + span', '#record-button', '#sample-select', '#backend-select',
-  '#play-button', '#scrub', '#time-label', '#paint-select', '#export-glb', '#export-raw', '#status', '#details'];
+  '#play-button', '#scrub', '#time-label', '#paint-select', '#export-video', '#export-glb', '#export-raw', '#status', '#details'];
 
 type Boxes = Record<string, { x: number; y: number; width: number; height: number }>;
 

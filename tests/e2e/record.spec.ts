@@ -78,7 +78,7 @@ test("while recording, the last take's playback rests; a file opened while the r
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
   await page.locator('#record-button').click();
   await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
-  for (const id of ['#play-button', '#scrub', '#export-glb', '#export-raw', '#head-reroll']) await expect(page.locator(id), id).toBeDisabled();
+  for (const id of ['#play-button', '#scrub', '#export-video', '#export-glb', '#export-raw', '#head-reroll']) await expect(page.locator(id), id).toBeDisabled();
   await page.locator('#face-canvas').focus();
   await page.keyboard.press('Space'); // play, by keyboard: not while the microphone drives the face
   await page.waitForTimeout(500);

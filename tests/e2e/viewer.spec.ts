@@ -88,7 +88,7 @@ test('at phone width every control is reachable without sideways scrolling, and 
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
   expect(await page.evaluate(() => document.documentElement.scrollWidth)).toBeLessThanOrEqual(375);
-  for (const id of ['#record-button', '#sample-select', '#play-button', '#scrub', '#paint-select', '#export-glb']) {
+  for (const id of ['#record-button', '#sample-select', '#play-button', '#scrub', '#paint-select', '#export-video', '#export-glb']) {
     const box = (await page.locator(id).boundingBox())!;
     expect(box.x, id).toBeGreaterThanOrEqual(0);
     expect(box.x + box.width, id).toBeLessThanOrEqual(376);
