@@ -273,10 +273,11 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     const notes = audioNotes(done.samples, done.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
     setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
-    tell(takeNote || 'Recording is ready: press Play.');
+    const held = done.heldFrames && `Stopped animating the whole take: it keeps the live frames (the ${done.heldFrames} skipped to keep up hold the frame before them). Press Play.`;
+    tell(held || takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';
   } catch (err) {
-    if (controller.signal.aborted) tell('Stopped finishing the recording: the take is discarded. Press Record to record again.');
+    if (controller.signal.aborted) tell('Stopped finishing the recording before any frame was made: the take is discarded. Press Record to record again.');
     else tell(`The recording could not be finished: ${(err as Error).message}`, true);
   } finally {
     finishing = false;

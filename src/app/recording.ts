@@ -1,10 +1,11 @@
 /**
  * The demo's microphone take: the face follows the voice live while recording; on stop, the streamed frames
- * become the take (or the whole take is animated again if frames were skipped to keep up).
+ * become the take (or the whole take is animated again if frames were skipped to keep up; cancelled, the take keeps
+ * the live frames, each skipped one holding the frame before it).
  */
 import type { TalkingFaceEngine, Animation, Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { joinFrames } from '../engine/frames';
+import { placeFrames } from '../engine/frames';
 import { openMicrophone } from '../audio/capture';
 
 export interface FinishedTake {
@@ -13,10 +14,12 @@ export interface FinishedTake {
   samples: Float32Array;
   seconds: number;
   computeMs: number;
+  /** Frames of the take that hold the one before them: skipped live, and their animation cancelled (else 0). */
+  heldFrames: number;
 }
 
 export class Recording {
-  private readonly frames: Frames[] = [];
+  private readonly frames: { first: number; frames: Frames }[] = [];
   private toldSlow = false;
 
   private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
@@ -26,10 +29,10 @@ export class Recording {
     const media = await openMicrophone();
     engine.resetTimes();
     let recording: Recording | null = null;
-    const pending: Frames[] = [];
-    const live = await engine.listen(media, (_, f) => {
-      (recording?.frames ?? pending).push(f);
-      onFrames(f);
+    const pending: { first: number; frames: Frames }[] = [];
+    const live = await engine.listen(media, (first, frames) => {
+      (recording?.frames ?? pending).push({ first, frames });
+      onFrames(frames);
     }, { onError });
     recording = new Recording(engine, live);
     recording.frames.push(...pending);
@@ -56,8 +59,8 @@ export class Recording {
 
   /**
    * Stop and return the take, or null when it is too short to animate (under 0.1 s). When frames were skipped live,
-   * the whole take is animated again: `onReanimate` is told its progress (frames done of all), and `signal` cancels it
-   * (the promise rejects with the abort's reason).
+   * the whole take is animated again: `onReanimate` is told its progress (frames done of all), and `signal` cancels
+   * that: the take is then the live frames, the skipped ones held (`heldFrames`), not lost.
    */
   async finish(onReanimate: (done: number, total: number) => void, signal?: AbortSignal): Promise<FinishedTake | null> {
     const e = this.engine;
@@ -68,15 +71,20 @@ export class Recording {
     buffer.copyToChannel(new Float32Array(samples), 0);
     const t = e.times;
     const computeMs = t.mel + t.content + t.hierarchical + t.pose + t.decoder + t.posing;
-    const streamed = this.frames.reduce((s, f) => s + f.count, 0);
-    let animation: Animation;
-    if (this.live.stream.skippedFrames === 0 && streamed === e.frameCount(samples.length)) {
-      animation = joinFrames(this.frames, e.fps);
-    } else {
+    const total = e.frameCount(samples.length);
+    const streamed = this.frames.reduce((s, c) => s + c.frames.count, 0);
+    const live = placeFrames(this.frames, total, e.fps);
+    let animation = live, heldFrames = 0;
+    if (this.live.stream.skippedFrames > 0 || streamed !== total) {
       // The device fell behind while live (frames were skipped to stay live): animate the take again, whole.
-      onReanimate(0, e.frameCount(samples.length));
-      animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
+      onReanimate(0, total);
+      try {
+        animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
+      } catch (err) {
+        if (!signal?.aborted || streamed === 0) throw err; // (no live frame to keep)
+        heldFrames = total - streamed;
+      }
     }
-    return { animation, buffer, samples, seconds: samples.length / rate, computeMs };
+    return { animation, buffer, samples, seconds: samples.length / rate, computeMs, heldFrames };
   }
 }

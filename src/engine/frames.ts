@@ -77,6 +77,42 @@ export function joinFrames(chunks: Frames[], fps: number): Animation {
   return { fps, frames: count, vertices, pose, unposed, phones, tongue, speech, blendshapes };
 }
 
+/**
+ * Streamed chunks placed at their first frames in an animation of `total` frames: where no chunk has a frame (a
+ * live stream skipped it to keep up, StreamingSession's maxLagFrames), the frame before it is held (before the
+ * first chunk, its first frame). With consecutive chunks from 0 this is joinFrames.
+ */
+export function placeFrames(chunks: { first: number; frames: Frames }[], total: number, fps: number): Animation {
+  const sorted = chunks.filter((c) => c.frames.count > 0).sort((a, b) => a.first - b.first);
+  const per = sorted.length ? sorted[0].frames.vertices.length / sorted[0].frames.count : 0;
+  const vertices = new Float32Array(total * per);
+  const unposed = new Float32Array(total * per);
+  const pose = new Float32Array(total * 6);
+  const phones = new Uint8Array(total);
+  const tongue = new Float32Array(total);
+  const speech = new Float32Array(total);
+  const blendshapes = sorted.length && sorted.every((c) => c.frames.blendshapes) ? emptyBlendshapes(total) : undefined;
+  let k = 0;
+  let from: Frames | null = sorted[0]?.frames ?? null, at = 0; // the frame shown at f: `from`'s frame `at`
+  for (let f = 0; f < total && from; f++) {
+    while (k < sorted.length && sorted[k].first + sorted[k].frames.count <= f) k++;
+    if (k < sorted.length && sorted[k].first <= f) [from, at] = [sorted[k].frames, f - sorted[k].first];
+    vertices.set(from.vertices.subarray(at * per, (at + 1) * per), f * per);
+    unposed.set(from.unposed.subarray(at * per, (at + 1) * per), f * per);
+    pose.set(from.pose.subarray(at * 6, at * 6 + 6), f * 6);
+    phones[f] = from.phones[at];
+    tongue[f] = from.tongue[at];
+    speech[f] = from.speech[at];
+    if (blendshapes && from.blendshapes) {
+      const b = from.blendshapes;
+      blendshapes.arkit.set(b.arkit.subarray(at * ARKIT_COUNT, (at + 1) * ARKIT_COUNT), f * ARKIT_COUNT);
+      blendshapes.visemes.set(b.visemes.subarray(at * VISEME_COUNT, (at + 1) * VISEME_COUNT), f * VISEME_COUNT);
+      blendshapes.headRotation.set(b.headRotation.subarray(at * 3, at * 3 + 3), f * 3);
+    }
+  }
+  return { fps, frames: total, vertices, pose, unposed, phones, tongue, speech, blendshapes };
+}
+
 /** Room for `frames` frames of blendshape output. */
 export function emptyBlendshapes(frames: number): BlendshapeFrames {
   return { arkit: new Float32Array(frames * ARKIT_COUNT), visemes: new Float32Array(frames * VISEME_COUNT), headRotation: new Float32Array(frames * 3) };

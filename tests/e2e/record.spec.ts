@@ -103,7 +103,7 @@ test("while recording, the last take's playback rests; a file opened while the r
   await expect(page.locator('#play-button')).toHaveText('Pause');
 });
 
-test('a take whose live frames were skipped is animated again with progress; Escape stops that and says the take is discarded', async ({ page }) => {
+test('a take whose live frames were skipped is animated again with progress; Escape stops that and keeps the live frames', async ({ page }) => {
   test.setTimeout(120_000);
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
@@ -131,10 +131,17 @@ test('a take whose live frames were skipped is animated again with progress; Esc
     }).observe(status, { childList: true, characterData: true, subtree: true });
   });
   await page.keyboard.press('Enter'); // Stop recording
-  await expect(page.locator('#status')).toHaveText('Stopped finishing the recording: the take is discarded. Press Record to record again.', { timeout: 30_000 });
+  await expect(page.locator('#status')).toHaveText(/^Stopped animating the whole take: it keeps the live frames \(the \d+ skipped to keep up hold the frame before them\)\. Press Play\.$/, { timeout: 30_000 });
   const statuses = await page.evaluate(() => (globalThis as unknown as { statuses: string[] }).statuses);
   expect(statuses.some((s) => /^Animating the whole take .*: frame 0 of \d+…$/.test(s)), statuses.join(' | ')).toBe(true);
-  await expect(page.locator('body')).not.toHaveAttribute('data-take', 'ready');
+  // The take is kept (before, it was discarded): every frame of the recording, playable.
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready');
+  const { frames, seconds } = await page.evaluate(() => {
+    const take = (globalThis as unknown as { talkingFace: { take: { animation: { frames: number; fps: number }; seconds: number } } }).talkingFace.take;
+    return { frames: take.animation.frames, seconds: take.seconds * take.animation.fps };
+  });
+  expect(Math.abs(frames - seconds)).toBeLessThanOrEqual(1);
+  await expect(page.locator('#play-button')).toBeEnabled();
   await expect(page.locator('#cancel-button')).toBeHidden();
   await expect(record, 'the focus stays on Record, enabled again').toBeFocused();
   await expect(record).toBeEnabled();

@@ -1,6 +1,9 @@
-/** joinFrames (src/engine/frames.ts): streamed chunks become one animation, every array in order. */
+/**
+ * joinFrames (src/engine/frames.ts): streamed chunks become one animation, every array in order; placeFrames: chunks
+ * with gaps between them (frames skipped live) placed at their frames, each gap holding the frame before it.
+ */
 import { describe, expect, it } from 'vitest';
-import { emptyBlendshapes, joinFrames, slicer, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
+import { emptyBlendshapes, joinFrames, placeFrames, slicer, yieldToEventLoop, type Frames } from '../../../src/engine/frames';
 
 const chunk = (first: number, count: number, n: number): Frames => ({
   count,
@@ -10,6 +13,21 @@ const chunk = (first: number, count: number, n: number): Frames => ({
   phones: Uint8Array.from({ length: count }, (_, i) => first + i),
   tongue: Float32Array.from({ length: count }, (_, i) => (first + i) / 10),
   speech: Float32Array.from({ length: count }, (_, i) => (first + i) / 100),
+});
+
+describe('placeFrames', () => {
+  it('places chunks at their frames and holds the frame before each gap', () => {
+    // Frames 0-2 and 6-7 streamed, 3-5 skipped, 8-9 not reached; the chunks out of order.
+    const a = placeFrames([{ first: 6, frames: chunk(6, 2, 1) }, { first: 0, frames: chunk(0, 3, 1) }], 10, 30);
+    expect(a.frames).toBe(10);
+    expect(Array.from(a.phones)).toEqual([0, 1, 2, 2, 2, 2, 6, 7, 7, 7]);
+    expect(Array.from(a.vertices.subarray(3 * 3, 4 * 3))).toEqual([6, 7, 8]); // frame 3 holds frame 2
+    expect(Array.from(a.unposed!.subarray(6 * 3, 7 * 3))).toEqual([-18, -19, -20]);
+    expect(Array.from(a.pose.subarray(9 * 6, 10 * 6))).toEqual([42, 43, 44, 45, 46, 47]); // frame 9 holds frame 7
+    // Consecutive chunks from 0: the same as joinFrames.
+    const chunks = [chunk(0, 3, 2), chunk(3, 4, 2)];
+    expect(placeFrames(chunks.map((frames, i) => ({ first: i * 3, frames })), 7, 30)).toEqual(joinFrames(chunks, 30));
+  });
 });
 
 describe('joinFrames', () => {
