@@ -4,7 +4,7 @@ import type { FaceTemplate } from '../template/face-template';
 import { exportGlb, rawFrames, download, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
 import { fileBaseName, isolated } from './names';
-import { recordTake, videoType } from './export-video';
+import { PlaybackStopped, recordTake, videoType } from './export-video';
 import type { Player } from '../player/player';
 
 /** The .glb or video being prepared (a long clip's takes seconds, a video as long as the take): Escape cancels it (cancelExport). */
@@ -18,7 +18,10 @@ export function cancelExport(): boolean {
 
 export async function exportGlbFile(animation: Animation, name: string, template: FaceTemplate, unitsPerMm: number): Promise<void> {
   // Busy, not disabled: a disabled button would drop the keyboard focus.
-  if (exporting) return;
+  if (exporting) {
+    if (ui.exportVideoButton.getAttribute('aria-busy')) tell('A video of the take is being recorded: wait for it, or press Escape to cancel it.');
+    return;
+  }
   const controller = (exporting = new AbortController());
   ui.exportGlbButton.setAttribute('aria-busy', 'true');
   try {
@@ -54,7 +57,7 @@ export function exportRawFile(animation: Animation, name: string, template: Face
 }
 
 /** Record the take playing, with its sound, and save it (export-video.ts); the button again or Escape cancels. */
-export async function exportVideoFile(player: Player, fps: number, name: string): Promise<void> {
+export async function exportVideoFile(view: { recording: boolean }, player: Player, fps: number, name: string): Promise<void> {
   if (exporting) {
     if (ui.exportVideoButton.getAttribute('aria-busy')) exporting.abort(); // the button again: cancel
     return;
@@ -66,14 +69,16 @@ export async function exportVideoFile(player: Player, fps: number, name: string)
   ui.exportVideoButton.setAttribute('aria-busy', 'true');
   try {
     const seconds = (frames / fps).toFixed(1);
-    const video = await recordTake(ui.canvas, player, fps, controller.signal,
+    ui.canvas.scrollIntoView({ block: 'nearest' }); // what is recorded, in sight
+    const video = await recordTake(ui.canvas, view, player, fps, controller.signal,
       (f) => showStatus(`Recording the video: ${(f / fps).toFixed(1)} of ${seconds} s… (Escape or Export video again cancels)`));
     const file = `${fileBaseName(name)}.${type.startsWith('video/mp4') ? 'mp4' : 'webm'}`;
     download(video, file);
     tell(`Saved ${isolated(file)}: the take as a video with its sound.`);
-    ui.exportInfo.textContent = `Exported a ${seconds} s video (${type}, ${(video.size / 1e6).toFixed(1)} MB) of the face as shown, with the take's sound.`;
+    ui.exportInfo.textContent = `Exported a video of the ${seconds} s take and the face going back to rest (${type}, ${(video.size / 1e6).toFixed(1)} MB): the face as shown, with the take's sound.`;
   } catch (err) {
     if (controller.signal.aborted) tell('Video cancelled.');
+    else if (err instanceof PlaybackStopped) tell(`Video stopped: ${err.message}.`);
     else tell(`The video could not be made: ${(err as Error).message}`, true);
   } finally {
     exporting = null;

@@ -2,8 +2,10 @@
  * The take as a video to share: the face's canvas as it plays the take from the start, with the take's sound,
  * recorded by the browser (MediaRecorder: WebM with VP9 or VP8 and Opus, or MP4 where a browser records only that).
  * It records in real time, so it takes as long as the take (and half a second more, for the face to go back to
- * rest); what the view shows is what is recorded (pose arrows, colours, the side-by-side view, the idle life).
- * Nothing leaves the page: the file is made in the browser and saved by the visitor.
+ * rest); what the face's canvas shows is what is recorded (pose arrows, colours, the idle life; not the ground
+ * truth's view beside it), drawn even while scrolled out of sight. The file has no duration in its header (as
+ * MediaRecorder writes it): players learn the length as they play it. Nothing leaves the page: the file is made
+ * in the browser and saved by the visitor.
  */
 import type { Player } from '../player/player';
 
@@ -11,6 +13,13 @@ import type { Player } from '../player/player';
 export const VIDEO_TYPES = ['video/webm;codecs=vp9,opus', 'video/webm;codecs=vp8,opus', 'video/webm', 'video/mp4'];
 /** How long the recording goes on after the take ends: the face blends back to rest (face-view.ts: 0.4 s). */
 const TAIL_MS = 500;
+
+/** Playback of the take was stopped before its end (Pause, a seek, another clip): the recording is dropped. */
+export class PlaybackStopped extends Error {
+  constructor() {
+    super('the take\'s playback was stopped before its end, so no video was saved');
+  }
+}
 
 /** The type this browser records video in, or null where it cannot. */
 export function videoType(): string | null {
@@ -23,39 +32,42 @@ export function videoType(): string | null {
  * cancels (the promise rejects with its reason); playback stopped by anything else rejects too (the video would
  * be cut short). `onProgress` is told the frame shown, a few times a second.
  */
-export async function recordTake(canvas: HTMLCanvasElement, player: Player, fps: number, signal: AbortSignal,
-  onProgress: (frame: number) => void): Promise<Blob> {
+export async function recordTake(canvas: HTMLCanvasElement, view: { recording: boolean }, player: Player, fps: number,
+  signal: AbortSignal, onProgress: (frame: number) => void): Promise<Blob> {
   const type = videoType();
   if (!type) throw new Error('this browser cannot record video (it has no MediaRecorder for WebM or MP4)');
   const frames = player.take?.frames ?? 0;
   if (!frames) throw new Error('there is no take to record');
   signal.throwIfAborted();
+  view.recording = true; // drawn even where scrolled out of sight (else the video has no picture)
+  player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
+  await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
   const video = canvas.captureStream(fps);
   const stream = new MediaStream([...video.getVideoTracks(), ...player.tap().getAudioTracks()]);
   const recorder = new MediaRecorder(stream, { mimeType: type, videoBitsPerSecond: 4_000_000 });
   const chunks: Blob[] = [];
   recorder.ondataavailable = (e) => e.data.size > 0 && chunks.push(e.data);
   const stopped = new Promise<void>((resolve) => (recorder.onstop = () => resolve()));
-  const loop = player.loop;
   const stopPlaying = () => player.stop();
   const progress = setInterval(() => onProgress(player.current), 250);
   try {
-    player.loop = false;
     signal.addEventListener('abort', stopPlaying, { once: true });
     recorder.start(1000);
-    await player.play(0);
+    await player.play(0, true); // (to the end, looping or not)
     signal.throwIfAborted();
-    if (player.current < frames - 1) throw new Error('playback was stopped before the end');
+    if (player.current < frames - 1) throw new PlaybackStopped();
     await new Promise((r) => setTimeout(r, TAIL_MS));
     signal.throwIfAborted();
   } finally {
     clearInterval(progress);
     signal.removeEventListener('abort', stopPlaying);
-    player.loop = loop;
     if (recorder.state !== 'inactive') recorder.stop();
     await stopped;
     player.untap();
+    view.recording = false;
     for (const t of video.getTracks()) t.stop();
   }
-  return new Blob(chunks, { type: type.split(';')[0] });
+  const file = new Blob(chunks, { type: type.split(';')[0] });
+  if (file.size === 0) throw new Error('the browser recorded nothing (is the face drawn on this page?)');
+  return file;
 }

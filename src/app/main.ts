@@ -313,7 +313,7 @@ bindControls({
   setSideBySide: (on) => { takeView.setSideBySide(on, take); publish(); if (take) player.show(player.current); },
   pick: (at) => takeView.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
-  exportVideo: () => take && void exportVideoFile(player, take.animation.fps, take.name),
+  exportVideo: () => take && void exportVideoFile(view, player, take.animation.fps, take.name),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),
   exportRaw: () => take && exportRawFile(take.animation, take.name, view.template),
   redrawHead: redrawTakeHead,

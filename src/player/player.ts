@@ -201,9 +201,9 @@ export class Player {
 
   /**
    * Play from `from` (default: the current frame, or the start when at the end) with the face in sync.
-   * Resolves when playback ends or is stopped.
+   * Resolves when playback ends or is stopped. `once`: to the end, whatever `loop` says.
    */
-  play(from?: number): Promise<void> {
+  play(from?: number, once = false): Promise<void> {
     const a = this.animation;
     if (!a || !this.buffer) return Promise.resolve();
     this.stop();
@@ -222,7 +222,7 @@ export class Player {
       source.onended = () => {
         if (this.playing !== playing) return;
         this.playing = null;
-        if (this.loop) {
+        if (this.loop && !once) {
           this.show(0);
           void this.play(0).then(resolve);
           return;

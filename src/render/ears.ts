@@ -23,7 +23,7 @@ const smooth = (a: number, b: number, x: number) => {
   return t * t * (3 - 2 * t);
 };
 
-/** The two ears for a head (left of the subject at -x first), skin-coloured (`skin`: the skin's colour). */
+/** The two ears for a head (the subject's right, at -x, first), skin-coloured (`skin`: the skin's colour). */
 export function earGeometries(m: FaceMeasures, egg: Egg, skin: THREE.Color): THREE.BufferGeometry[] {
   const H = m.top - m.chin;
   const h = 0.34 * H, w = 0.19 * H, t = 0.045 * H; // height, width, the rim's thickness

@@ -40,9 +40,8 @@ export interface FaceViewOptions {
 
 /** Seconds for speech to blend in, and back out to the rest face. */
 const BLEND_IN = 0.12, BLEND_OUT = 0.4;
-const scratchAxis = new THREE.Vector3();
+const scratchAxis = new THREE.Vector3(), eyeTarget = new THREE.Vector3();
 const scratchQ = new THREE.Quaternion();
-const eyeTarget = new THREE.Vector3();
 
 export class FaceView {
   readonly renderer: THREE.WebGLRenderer;
@@ -68,6 +67,7 @@ export class FaceView {
   private speech = 1;
   private speechTarget = 1;
   private tongue = 0;
+  recording = false; // draw even while out of sight (a recording of the canvas needs its frames: app/export-video.ts)
   private readonly pose = new Float32Array(6);
   private readonly resizeObserver: ResizeObserver;
   private readonly onScreen: OnScreen;
@@ -304,7 +304,7 @@ export class FaceView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
-    if (!this.onScreen.shown) return; // (its life and camera catch up when it is shown again)
+    if (!this.onScreen.shown && !this.recording) return; // (its life and camera catch up when it is shown again)
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
     if ((this.idle && this.alive) || this.idleState || this.speech !== this.speechTarget) this.update(performance.now() / 1000);

@@ -127,7 +127,7 @@ export class Head {
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
-    const ears = this.shell ? earGeometries(m, this.shell.egg, SKIN).map((g, k) => Object.assign(new THREE.Mesh(g, this.skin.material[0]), { name: k ? 'ear_right' : 'ear_left' })) : [];
+    const ears = this.shell ? earGeometries(m, this.shell.egg, SKIN).map((g, k) => Object.assign(new THREE.Mesh(g, this.skin.material[0]), { name: k ? 'ear_left' : 'ear_right' })) : [];
     this.group.add(this.skin, this.eyes.left, this.eyes.right, ...sockets, ...ears, upper, this.jaw, neck);
 
     const body = new THREE.Mesh(new THREE.SphereGeometry(1, 48, 24, 0, Math.PI * 2, 0, Math.PI * 0.62), clothMaterial());

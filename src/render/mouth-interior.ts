@@ -161,7 +161,7 @@ function arch(f: MouthFrame, upper: boolean): THREE.BufferGeometry {
       s += w;
       const tall = height * (k < 3 ? 1 : 0.8);
       const tooth = new RoundedBoxGeometry(w * 1.02, tall, (k < 2 ? 0.055 : 0.1 + 0.02 * k) * W, 2, w * 0.15);
-      tooth.rotateY(-side * Math.atan(2 * curve * mid));
+      tooth.rotateY(side * Math.atan(2 * curve * mid)); // its outer end back, along the arch
       // Each crown hangs from (upper) or stands on (lower) the gum line, its biting edge at `edge`.
       const y = upper ? edge + tall / 2 + rise : edge - tall / 2 - rise;
       tooth.translate(f.center[0] + side * mid, y, front - curve * mid * mid);

@@ -18,6 +18,8 @@ test('Export video saves the take playing, picture and sound; Escape cancels one
   const download = page.waitForEvent('download', { timeout: 60_000 });
   await page.locator('#export-video').click();
   await expect(page.locator('#status')).toContainText(/Recording the video: \d+\.\d of \d+\.\d s/);
+  // The face goes out of sight meanwhile (as scrolled away): it is still recorded (a view out of sight draws nothing).
+  await page.evaluate(() => ((document.querySelector('#face-canvas') as HTMLElement).style.transform = 'translateX(-10000px)'));
   const saved = await download;
   expect(saved.suggestedFilename()).toBe('speech-kal.webm');
   await expect(page.locator('#status')).toContainText('Saved speech-kal.webm: the take as a video with its sound.');
@@ -31,19 +33,28 @@ test('Export video saves the take playing, picture and sound; Escape cancels one
     video.muted = true;
     video.src = URL.createObjectURL(new Blob([data], { type: 'video/webm' }));
     await new Promise((resolve, reject) => { video.onloadedmetadata = resolve; video.onerror = () => reject(new Error('the video does not load')); });
-    // A frame a second in: the face, not a blank picture (the spread of its pixels' brightness).
-    await video.play();
-    await new Promise<void>((resolve) => { const check = () => (video.currentTime > 1 ? resolve() : requestAnimationFrame(check)); check(); });
-    video.pause();
+    // Frames at 1.2 s and 2.4 s in (the face out of sight): the face, not a blank picture (the spread of the
+    // pixels' brightness), and moving, not frozen (their mean difference).
     const still = Object.assign(document.createElement('canvas'), { width: video.videoWidth, height: video.videoHeight });
-    const ctx = still.getContext('2d')!;
-    ctx.drawImage(video, 0, 0);
-    const px = ctx.getImageData(0, 0, still.width, still.height).data;
-    let sum = 0, sq = 0;
-    for (let i = 0; i < px.length; i += 4) { const l = (px[i] + px[i + 1] + px[i + 2]) / 3; sum += l; sq += l * l; }
-    const n = px.length / 4;
+    const ctx = still.getContext('2d', { willReadFrequently: true })!;
+    const frameAt = async (t: number) => {
+      await video.play();
+      await new Promise<void>((resolve) => { const check = () => (video.currentTime > t ? resolve() : requestAnimationFrame(check)); check(); });
+      video.pause();
+      ctx.drawImage(video, 0, 0);
+      return ctx.getImageData(0, 0, still.width, still.height).data;
+    };
+    const early = await frameAt(1.2), late = await frameAt(2.4);
+    let sum = 0, sq = 0, moved = 0;
+    for (let i = 0; i < late.length; i += 4) {
+      const l = (late[i] + late[i + 1] + late[i + 2]) / 3;
+      sum += l; sq += l * l;
+      moved += Math.abs(l - (early[i] + early[i + 1] + early[i + 2]) / 3);
+    }
+    const n = late.length / 4;
     const canvas = document.querySelector('#face-canvas') as HTMLCanvasElement;
-    return { seconds: sound.duration, peak, width: video.videoWidth, height: video.videoHeight, canvas: [canvas.width, canvas.height], spread: Math.sqrt(sq / n - (sum / n) ** 2) };
+    return { seconds: sound.duration, peak, width: video.videoWidth, height: video.videoHeight, canvas: [canvas.width, canvas.height],
+      spread: Math.sqrt(sq / n - (sum / n) ** 2), moved: moved / n };
   }, bytes.toString('base64'));
   // The take and half a second after it (the face going back to rest), give or take the recorder's start.
   expect(read.seconds).toBeGreaterThan(seconds - 0.3);
@@ -51,6 +62,9 @@ test('Export video saves the take playing, picture and sound; Escape cancels one
   expect(read.peak).toBeGreaterThan(0.05);
   expect([read.width, read.height]).toEqual(read.canvas);
   expect(read.spread).toBeGreaterThan(10); // a face on the background (a blank frame: 0)
+  console.log(`video read back: ${JSON.stringify(read)}`);
+  expect(read.moved).toBeGreaterThan(0.2); // frozen: 0
+  await page.evaluate(() => ((document.querySelector('#face-canvas') as HTMLElement).style.transform = ''));
 
   const later: string[] = [];
   page.on('download', (d) => later.push(d.suggestedFilename()));
