@@ -39,18 +39,19 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
   const frames = player.take?.frames ?? 0;
   if (!frames) throw new Error('there is no take to record');
   signal.throwIfAborted();
-  view.recording = true; // drawn even where scrolled out of sight (else the video has no picture)
-  player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
-  await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
-  const video = canvas.captureStream(fps);
-  const stream = new MediaStream([...video.getVideoTracks(), ...player.tap().getAudioTracks()]);
-  const recorder = new MediaRecorder(stream, { mimeType: type, videoBitsPerSecond: 4_000_000 });
   const chunks: Blob[] = [];
-  recorder.ondataavailable = (e) => e.data.size > 0 && chunks.push(e.data);
-  const stopped = new Promise<void>((resolve) => (recorder.onstop = () => resolve()));
   const stopPlaying = () => player.stop();
   const progress = setInterval(() => onProgress(player.current), 250);
+  let video: MediaStream | null = null, recorder: MediaRecorder | null = null;
+  view.recording = true; // drawn even where scrolled out of sight (else the video has no picture)
   try {
+    player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
+    await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    signal.throwIfAborted();
+    video = canvas.captureStream(fps);
+    recorder = new MediaRecorder(new MediaStream([...video.getVideoTracks(), ...player.tap().getAudioTracks()]),
+      { mimeType: type, videoBitsPerSecond: 4_000_000 });
+    recorder.ondataavailable = (e) => e.data.size > 0 && chunks.push(e.data);
     signal.addEventListener('abort', stopPlaying, { once: true });
     recorder.start(1000);
     await player.play(0, true); // (to the end, looping or not)
@@ -61,11 +62,11 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
   } finally {
     clearInterval(progress);
     signal.removeEventListener('abort', stopPlaying);
-    if (recorder.state !== 'inactive') recorder.stop();
-    await stopped;
+    const r = recorder;
+    if (r && r.state !== 'inactive') await new Promise((done) => { r.onstop = done; r.stop(); }); // its last data comes first
     player.untap();
     view.recording = false;
-    for (const t of video.getTracks()) t.stop();
+    for (const t of video?.getTracks() ?? []) t.stop();
   }
   const file = new Blob(chunks, { type: type.split(';')[0] });
   if (file.size === 0) throw new Error('the browser recorded nothing (is the face drawn on this page?)');
