@@ -73,17 +73,16 @@ export class Recording {
     const computeMs = t.mel + t.content + t.hierarchical + t.pose + t.decoder + t.posing;
     const total = e.frameCount(samples.length);
     const streamed = this.frames.reduce((s, c) => s + c.frames.count, 0);
-    const live = placeFrames(this.frames, total, e.fps);
-    let animation = live, heldFrames = 0;
-    if (this.live.stream.skippedFrames > 0 || streamed !== total) {
-      // The device fell behind while live (frames were skipped to stay live): animate the take again, whole.
-      onReanimate(0, total);
-      try {
-        animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
-      } catch (err) {
-        if (!signal?.aborted || streamed === 0) throw err; // (no live frame to keep)
-        heldFrames = total - streamed;
-      }
+    if (this.live.stream.skippedFrames === 0 && streamed === total)
+      return { animation: placeFrames(this.frames, total, e.fps), buffer, samples, seconds: samples.length / rate, computeMs, heldFrames: 0 };
+    // The device fell behind while live (frames were skipped to stay live): animate the take again, whole.
+    let animation: Animation, heldFrames = 0;
+    onReanimate(0, total);
+    try {
+      animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
+    } catch (err) {
+      if (!signal?.aborted || streamed === 0) throw err; // (no live frame to keep)
+      [animation, heldFrames] = [placeFrames(this.frames, total, e.fps), total - streamed]; // (not made before: a long take's frames are large)
     }
     return { animation, buffer, samples, seconds: samples.length / rate, computeMs, heldFrames };
   }
