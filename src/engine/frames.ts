@@ -52,35 +52,17 @@ export interface StageTimes {
   blendshapes: number;
 }
 
-/** Chunks of streamed frames joined into one animation (they must be consecutive). */
+/** Chunks of streamed frames joined into one animation (they must be consecutive, from frame 0): placeFrames without gaps. */
 export function joinFrames(chunks: Frames[], fps: number): Animation {
-  const count = chunks.reduce((s, f) => s + f.count, 0);
-  const per = chunks[0]?.vertices.length / Math.max(1, chunks[0]?.count ?? 1) || 0;
-  const vertices = new Float32Array(count * per);
-  const unposed = new Float32Array(count * per);
-  const pose = new Float32Array(count * 6);
-  const phones = new Uint8Array(count);
-  const blendshapes = chunks.every((f) => f.blendshapes) && count > 0 ? emptyBlendshapes(count) : undefined;
-  const tongue = new Float32Array(count);
-  const speech = new Float32Array(count);
-  let i = 0;
-  for (const f of chunks) {
-    vertices.set(f.vertices, i * per);
-    unposed.set(f.unposed, i * per);
-    pose.set(f.pose, i * 6);
-    phones.set(f.phones, i);
-    if (blendshapes) setBlendshapes(blendshapes, f.blendshapes!, i);
-    tongue.set(f.tongue, i);
-    speech.set(f.speech, i);
-    i += f.count;
-  }
-  return { fps, frames: count, vertices, pose, unposed, phones, tongue, speech, blendshapes };
+  let first = 0;
+  const placed = chunks.map((frames) => ({ first: (first += frames.count) - frames.count, frames }));
+  return placeFrames(placed, first, fps);
 }
 
 /**
  * Streamed chunks placed at their first frames in an animation of `total` frames: where no chunk has a frame (a
  * live stream skipped it to keep up, StreamingSession's maxLagFrames), the frame before it is held (before the
- * first chunk, its first frame). With consecutive chunks from 0 this is joinFrames.
+ * first chunk, its first frame).
  */
 export function placeFrames(chunks: { first: number; frames: Frames }[], total: number, fps: number): Animation {
   const sorted = chunks.filter((c) => c.frames.count > 0).sort((a, b) => a.first - b.first);

@@ -10,7 +10,7 @@
  * their own). Pure geometry apart from the colour attribute.
  */
 import * as THREE from 'three';
-import type { Egg, FaceMeasures } from './head-shell';
+import { SQUARENESS, type Egg, type FaceMeasures } from './head-shell';
 
 /** How far the ear's back edge stands out from the head (radians about its front edge). */
 const STAND_OUT = 0.38;
@@ -28,10 +28,10 @@ export function earGeometries(m: FaceMeasures, egg: Egg, skin: THREE.Color): THR
   const H = m.top - m.chin;
   const h = 0.34 * H, w = 0.19 * H, t = 0.045 * H; // height, width, the rim's thickness
   const cy = m.eyeY - 0.11 * H, cz = egg.center[2] - 0.09 * H;
-  // Where the egg's surface is at the ear's middle (its superellipsoid, exponent as head-shell's SQUARENESS).
+  // Where the egg's surface is at the ear's middle (its superellipsoid).
   const uy = Math.abs(cy - egg.center[1]) / (cy >= egg.center[1] ? egg.up : egg.down);
   const uz = Math.abs(cz - egg.center[2]) / (cz >= egg.center[2] ? egg.front : egg.back);
-  const side = egg.ax * Math.max(0, 1 - uy ** 2.5 - uz ** 2.5) ** (1 / 2.5);
+  const side = egg.ax * Math.max(0, 1 - uy ** SQUARENESS - uz ** SQUARENESS) ** (1 / SQUARENESS);
   return [-1, 1].map((s) => ear(h, w, t, skin, (u, v, out) => [egg.center[0] + s * (side - 0.15 * t + out), cy + v, cz + u], s < 0));
 }
 

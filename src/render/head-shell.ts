@@ -18,7 +18,7 @@ import { boundaryLoops } from '../template/mesh-topology';
 /** Rings from the oval to the back pole (the pole is one more vertex); rings after the oval have twice its columns. */
 const RINGS = 18;
 /** The egg's squareness: 2 is an ellipsoid; more fills out the crown and the temples as a skull does. */
-const SQUARENESS = 2.5;
+export const SQUARENESS = 2.5;
 
 /** The egg the shell lies on: centre and the four half-axes (template units). */
 export interface Egg {

@@ -6,7 +6,7 @@
 import { describe, expect, it } from 'vitest';
 import * as THREE from 'three';
 import { earGeometries } from '../../../src/render/ears';
-import { headShell } from '../../../src/render/head-shell';
+import { headShell, SQUARENESS } from '../../../src/render/head-shell';
 import { boundaryLoops } from '../../../src/template/mesh-topology';
 import { loadManifest, loadTemplateFile } from '../helpers/exported';
 
@@ -20,8 +20,8 @@ describe('earGeometries', () => {
     expect(ears).toHaveLength(2);
     /** The egg's implicit value at a point (head-shell.ts: 1 on its surface, less inside). */
     const inEgg = (x: number, y: number, z: number) =>
-      Math.abs((x - egg.center[0]) / egg.ax) ** 2.5 + Math.abs((y - egg.center[1]) / (y >= egg.center[1] ? egg.up : egg.down)) ** 2.5
-      + Math.abs((z - egg.center[2]) / (z >= egg.center[2] ? egg.front : egg.back)) ** 2.5;
+      Math.abs((x - egg.center[0]) / egg.ax) ** SQUARENESS + Math.abs((y - egg.center[1]) / (y >= egg.center[1] ? egg.up : egg.down)) ** SQUARENESS
+      + Math.abs((z - egg.center[2]) / (z >= egg.center[2] ? egg.front : egg.back)) ** SQUARENESS;
     const boxes = ears.map((g) => {
       const pos = g.getAttribute('position') as THREE.BufferAttribute;
       const index = Uint32Array.from(g.getIndex()!.array);
