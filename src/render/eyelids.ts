@@ -3,9 +3,10 @@
  * 1 (closed), to close its lids over the eyes, at rest and during speech where the model's own lids are open
  * (lidOpening: a model that blinks by itself is not closed twice).
  *
- * For each eye the upper lid's contour travels 80% of the way down to the lower contour below it and the lower
- * contour 20% up, so they meet; the skin within reach of a contour follows its nearest contour vertex, fading
- * with distance (like the corpus rig's lid fields). The eye corners stay.
+ * For each eye the upper lid's contour travels 90% of the way down to the lower contour below it and the lower
+ * contour 20% up, so the upper lid passes over the lower by a tenth of the opening (edges that only met showed the
+ * white between their vertices, a dotted line from below); the skin within reach of a contour follows its nearest
+ * contour vertex, fading with distance (like the corpus rig's lid fields). The eye corners stay.
  */
 import type { FaceTemplate } from '../template/face-template';
 
@@ -28,7 +29,7 @@ export function blinkField(t: FaceTemplate): Float32Array {
       return p[3 * a + k] + f * (p[3 * b + k] - p[3 * a + k]);
     };
     const contour = new Map<number, number[]>();
-    for (const [own, other, share] of [[up, lo, 0.8], [lo, up, 0.2]] as const) {
+    for (const [own, other, share] of [[up, lo, 0.9], [lo, up, 0.2]] as const) {
       for (const v of own) {
         if (corners.has(v)) continue;
         const x = p[3 * v];
