@@ -10,9 +10,13 @@
  * of its surface (a lid corner at rest, a closing lid passing over the front) are pushed out along the ball's radius
  * to it, so the white does not show through the skin. The clearance is what a triangle of the skin there sags
  * inside a sphere through its corners, so its faces stay out too, not only its vertices.
+ *
+ * Behind each opening a skirt (eyeSkirts) runs from the lid edge round the ball to behind its middle, so a look into
+ * the opening from any side meets the ball or the skirt, never the inside of the head or the page behind it.
  */
 import * as THREE from 'three';
 import type { FaceTemplate } from '../template/face-template';
+import { boundaryLoops } from '../template/mesh-topology';
 import { eyeMaterial } from './materials';
 
 /** Largest turn of the eyes from straight ahead (radians): people turn the head beyond about this. */
@@ -133,4 +137,67 @@ function sag(t: FaceTemplate, near: Uint32Array, radius: number): number {
     }
   }
   return (longest * longest) / (6 * radius);
+}
+
+/** How far round from the front the skirts reach behind the balls (radians), and their radius there (ball radii). */
+const SKIRT_BACK = 0.6 * Math.PI;
+const SKIRT_RADIUS = 1.1;
+
+/**
+ * The skirts behind the eye openings, in a joined buffer after `first`: per eye a front ring, a copy of the opening's
+ * loop of face vertices made every frame (updateSkirts; copies, so the lids' normals stay their own), and a back ring
+ * that stays, on a sphere a little larger than the ball, behind its middle, each vertex out from the ball's axis the
+ * way its front vertex is.
+ */
+export interface EyeSkirts {
+  /** Per eye, the opening's loop of face vertices. */
+  rims: number[][];
+  /** (2 x sum of the rims' lengths, x 3) the skirts' vertices: per eye its front ring, then its back ring. */
+  rest: Float32Array;
+  /** Triangles in the joined buffer's indices, facing the ball's axis (what a look into the opening sees). */
+  triangles: Uint32Array;
+  first: number;
+}
+
+export function eyeSkirts(t: FaceTemplate, centers: THREE.Vector3[], radii: number[], first: number): EyeSkirts | null {
+  const loops = boundaryLoops(t.triangles);
+  const rims = (['left', 'right'] as const).map((side) => {
+    const lids = new Set([...t.regions[`eye_${side}_upper`], ...t.regions[`eye_${side}_lower`]]);
+    return loops.find((l) => l.filter((v) => lids.has(v)).length >= 0.8 * lids.size);
+  });
+  if (rims.some((r) => !r)) return null;
+  const p = t.positions;
+  const rest = new Float32Array(2 * 3 * (rims[0]!.length + rims[1]!.length));
+  const tris: number[] = [];
+  let at = 0;
+  rims.forEach((rim, k) => {
+    const c = centers[k], R = SKIRT_RADIUS * radii[k], M = rim!.length;
+    rim!.forEach((v, i) => {
+      rest.set([p[3 * v], p[3 * v + 1], p[3 * v + 2]], 3 * (at + i));
+      const dx = p[3 * v] - c.x, dy = p[3 * v + 1] - c.y, d = Math.hypot(dx, dy) || 1;
+      const out = R * Math.sin(SKIRT_BACK) / d;
+      rest.set([c.x + dx * out, c.y + dy * out, c.z + R * Math.cos(SKIRT_BACK)], 3 * (at + M + i));
+    });
+    const front = (i: number) => first + at + (i % M), back = (i: number) => first + at + M + (i % M);
+    // Wound so the first quad's normal points at the ball's axis; the rest follow it round the loop.
+    const a = scratch.fromArray(rest, 3 * at), b = new THREE.Vector3().fromArray(rest, 3 * (at + 1)), q = new THREE.Vector3().fromArray(rest, 3 * (at + M));
+    const normal = new THREE.Vector3().subVectors(b, a).cross(q.sub(a));
+    const inward = new THREE.Vector3(c.x - a.x, c.y - a.y, 0);
+    const flip = normal.dot(inward) < 0;
+    for (let i = 0; i < M; i++) {
+      if (flip) tris.push(front(i), back(i), front(i + 1), front(i + 1), back(i), back(i + 1));
+      else tris.push(front(i), front(i + 1), back(i), front(i + 1), back(i + 1), back(i));
+    }
+    at += 2 * M;
+  });
+  return { rims: rims as number[][], rest, triangles: Uint32Array.from(tris), first };
+}
+
+/** Copy each opening's loop, as `positions` (the joined buffer) holds it now, into its skirt's front ring there. */
+export function updateSkirts(s: EyeSkirts, positions: Float32Array): void {
+  let at = s.first;
+  for (const rim of s.rims) {
+    for (let i = 0; i < rim.length; i++) positions.copyWithin(3 * (at + i), 3 * rim[i], 3 * rim[i] + 3);
+    at += 2 * rim.length;
+  }
 }

@@ -1,8 +1,8 @@
 /**
  * The whole head as three.js objects, built from a face template: one skin mesh whose vertex buffer is the face's
  * N vertices (what the model animates), then the head shell's (head-shell.ts), then the mouth cavity's
- * (mouth-interior.ts), drawn with two materials (skin; the inside of the mouth); the neck; the eyes (eyes.ts) in
- * dark sockets (the mouth's material);
+ * (mouth-interior.ts), then the skirts behind the eye openings (eyes.ts), drawn with three materials (skin; the
+ * inside of the mouth; the eyes' inner corners); the neck; the eyes (eyes.ts) in dark sockets (the mouth's material);
  * upper teeth fixed to the skull; lower teeth and tongue on the jaw (jaw.ts). `group` is what the head pose moves.
  *
  * `setFace(face, tongue)` poses everything that follows the face for one frame of it: the skin is kept outside the
@@ -14,10 +14,10 @@ import type { FaceTemplate } from '../template/face-template';
 import { headShell, faceMeasures, ovalLoop, type HeadShell, type FaceMeasures } from './head-shell';
 import { JawEstimator, jawHinge, turnAboutHinge, type Hinge } from './jaw';
 import { mouthBag, mouthFrame, teethGeometry, tongueGeometry, updateBag, type MouthBag } from './mouth-interior';
-import { Eyes } from './eyes';
+import { Eyes, eyeSkirts, updateSkirts, type EyeSkirts } from './eyes';
 import { earGeometries } from './ears';
 import { PartialNormals } from './normals';
-import { SKIN, cavityMaterial, clothMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
+import { SKIN, cavityMaterial, clothMaterial, eyeCornerMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
 
 const scratch = [0, 0];
 /** An eye socket's radius against its ball's, and how far round the ball it reaches from the back (radians). */
@@ -49,6 +49,8 @@ export class Head {
   private readonly normals: THREE.BufferAttribute;
   private readonly partialNormals: PartialNormals;
   private readonly n: number;
+  /** Behind the eye openings, after the mouth's cavity in the joined buffer. */
+  private readonly skirts: EyeSkirts | null;
 
   constructor(readonly template: FaceTemplate) {
     const t = template;
@@ -59,13 +61,17 @@ export class Head {
     const S = this.shell ? this.shell.positions.length / 3 : 0;
     this.bag = mouthBag(t, this.n + S);
     const B = this.bag ? this.bag.rest.length / 3 : 0;
+    this.eyes = new Eyes(t);
+    this.skirts = eyeSkirts(t, this.eyes.centers, this.eyes.radii, this.n + S + B);
+    const E = this.skirts ? this.skirts.rest.length / 3 : 0;
     this.hinge = jawHinge(t, m);
     this.estimator = new JawEstimator(t, m, this.hinge);
 
-    const all = new Float32Array((this.n + S + B) * 3);
+    const all = new Float32Array((this.n + S + B + E) * 3);
     all.set(t.positions);
     if (this.shell) all.set(this.shell.positions, this.n * 3);
     if (this.bag) all.set(this.bag.rest, (this.n + S) * 3);
+    if (this.skirts) all.set(this.skirts.rest, (this.n + S + B) * 3);
     const geometry = new THREE.BufferGeometry();
     this.positions = new THREE.BufferAttribute(all, 3);
     this.positions.setUsage(THREE.DynamicDrawUsage);
@@ -75,17 +81,19 @@ export class Head {
     geometry.setAttribute('color', new THREE.BufferAttribute(this.colors.slice(), 3));
     const skinTris = this.shell ? [...t.triangles, ...this.shell.triangles] : [...t.triangles];
     const bagTris = this.bag ? [...this.bag.triangles] : [];
-    geometry.setIndex([...skinTris, ...bagTris]);
+    const skirtTris = this.skirts ? [...this.skirts.triangles] : [];
+    geometry.setIndex([...skinTris, ...bagTris, ...skirtTris]);
     geometry.addGroup(0, skinTris.length, 0);
     if (bagTris.length) geometry.addGroup(skinTris.length, bagTris.length, 1);
-    // What moves per frame: the face, the shell where it turns with the jaw, the mouth's cavity.
+    if (skirtTris.length) geometry.addGroup(skinTris.length + bagTris.length, skirtTris.length, 2);
+    // What moves per frame: the face, the shell where it turns with the jaw, the mouth's cavity, the eyes' skirts.
     const jawW = this.shell?.jawWeights;
     const moving = (v: number) => v < this.n || v >= this.n + S || (jawW !== undefined && jawW[v - this.n] > 0);
     this.partialNormals = new PartialNormals(geometry.getIndex()!.array, all, moving);
     this.normals = new THREE.BufferAttribute(new Float32Array(all.length), 3);
     this.partialNormals.init(all, this.normals.array as Float32Array);
     geometry.setAttribute('normal', this.normals);
-    this.skin = new THREE.Mesh(geometry, [skinMaterial(), cavityMaterial()]);
+    this.skin = new THREE.Mesh(geometry, [skinMaterial(), cavityMaterial(), eyeCornerMaterial()]);
     this.skin.name = 'face';
 
     const f = mouthFrame(t);
@@ -105,7 +113,6 @@ export class Head {
     onJaw.add(lower, this.tongue);
     this.jaw.add(onJaw);
 
-    this.eyes = new Eyes(t);
     // Behind each eye a dark cup (the mouth's material: no shader program of its own), a sphere a little larger than
     // the ball from its back to 45 degrees in front of its middle: the gaps between the lids and the ball show a socket,
     // not the page behind, from the front to the side (head.spec.ts; reaching only 22 degrees in front, 7% of the
@@ -154,6 +161,7 @@ export class Head {
     const all = this.positions.array as Float32Array;
     for (let i = 0; i < this.n * 3; i++) all[i] = face[i];
     this.eyes.clearance.apply(all); // the lids over the balls, not through them
+    if (this.skirts) updateSkirts(this.skirts, all);
     // The jaw may close past the template (the rest face) but the lower teeth stop at the upper ones.
     this.jawAngle = Math.max(-0.09, this.estimator.angle(face));
     const a = this.jawAngle;

@@ -49,6 +49,14 @@ export function cavityMaterial(): THREE.MeshStandardMaterial {
   return new THREE.MeshStandardMaterial({ name: 'mouth', color: 0x2e0e12, roughness: 0.8, side: THREE.DoubleSide });
 }
 
+/**
+ * The skirts behind the eye openings (eyes.ts): moist pink flesh, as the inner corner's caruncle is, where the lids
+ * leave a gap beside the ball. The cavity's settings but its colour, so three.js draws it with the same program.
+ */
+export function eyeCornerMaterial(): THREE.MeshStandardMaterial {
+  return new THREE.MeshStandardMaterial({ name: 'eye_corner', color: 0xb88078, emissive: 0x6a3c38, roughness: 0.8, side: THREE.DoubleSide });
+}
+
 export function teethMaterial(): THREE.MeshStandardMaterial {
   return new THREE.MeshStandardMaterial({ name: 'teeth', color: 0xeee6d6, roughness: 0.3, envMapIntensity: 0.5 });
 }
