@@ -130,7 +130,7 @@ export class Head {
     const neck = new THREE.Mesh(new THREE.CylinderGeometry(0.66 * m.halfWidth, 0.74 * m.halfWidth, 0.72 * H, 28, 4, true), this.skin.material[0]);
     neck.name = 'neck';
     neck.scale.z = 1.05;
-    neck.geometry.setAttribute('color', new THREE.BufferAttribute(plainColors(neck.geometry, SKIN), 3));
+    neck.geometry.setAttribute('color', new THREE.BufferAttribute(neckColors(neck.geometry, 0.1 * H, 0.3 * H), 3));
     neck.position.set(m.centerX, m.chin - 0.1 * H, m.sideZ - 0.2 * m.halfWidth);
     neck.rotation.x = 0.12;
     this.group.name = 'head';
@@ -219,3 +219,19 @@ function plainColors(g: THREE.BufferGeometry, color: THREE.Color): Float32Array 
   return c;
 }
 const WHITE = new THREE.Color(1, 1, 1);
+
+/**
+ * The neck's skin, shaded darker towards the jaw it goes up into (as the chin's shadow falls on it): full colour
+ * below `from` under the chin (the neck's own frame: its centre 0.1 H under the chin), `SHADE` of it `over` higher up.
+ * Lit evenly, the neck met the underside of the jaw, which faces away from the light, along a hard bright edge.
+ */
+function neckColors(g: THREE.BufferGeometry, chin: number, over: number): Float32Array {
+  const c = plainColors(g, SKIN), pos = g.getAttribute('position');
+  for (let i = 0; i < pos.count; i++) {
+    const u = Math.min(1, Math.max(0, (pos.getY(i) - chin + over) / over));
+    const k = 1 - (1 - SHADE) * u * u * (3 - 2 * u);
+    for (let j = 0; j < 3; j++) c[3 * i + j] *= k;
+  }
+  return c;
+}
+const SHADE = 0.55;
