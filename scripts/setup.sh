@@ -31,7 +31,10 @@ ensure_apt() {
 
 ensure_node_modules() {
   cd "$REPO_ROOT"
-  command -v npm >/dev/null || { say "Node.js 20+ with npm is required (https://nodejs.org)"; return 1; }
+  command -v npm >/dev/null || { say "Node.js 20.19+ or 22.12+ with npm is required (https://nodejs.org)"; return 1; }
+  # Vite 8 needs ^20.19.0 || >=22.12.0: say so here rather than fail later inside the build.
+  node -e 'const [a, b] = process.versions.node.split(".").map(Number); process.exit((a === 20 && b >= 19) || (a === 22 && b >= 12) || a > 22 ? 0 : 1)' ||
+    { say "Node.js 20.19+ or 22.12+ is required (found: $(node --version))"; return 1; }
   local stamp=node_modules/.talking-face-lock
   local want
   want="$(sha256sum package-lock.json | cut -d' ' -f1)"
@@ -58,13 +61,19 @@ ensure_corpus_tools() {
 UV_VERSION="$(sed -n 's/^uv==\([0-9.]*\).*/\1/p' "$REPO_ROOT/scripts/uv-requirements.txt")"
 UV_HOME="${TALKING_FACE_UV_HOME:-$HOME/.cache/talking-face/uv}"
 
+# training/pyproject.toml: requires-python >=3.11,<3.13 (what the lock was resolved for).
+ensure_python() {
+  local py="${PYTHON:-python3}"
+  "$py" -c 'import sys; assert (3, 11) <= sys.version_info[:2] <= (3, 12)' 2>/dev/null ||
+    { say "Python 3.11 or 3.12 is required (found: $("$py" --version 2>&1); another one can be named with PYTHON=...)"; return 1; }
+}
+
 ensure_uv() {
   if command -v uv >/dev/null && [ "$(uv --version | cut -d' ' -f2)" = "$UV_VERSION" ]; then UV=uv; return 0; fi
   UV="$UV_HOME/bin/uv"
   if [ -x "$UV" ] && [ "$("$UV" --version | cut -d' ' -f2)" = "$UV_VERSION" ]; then return 0; fi
   local py="${PYTHON:-python3}"
-  "$py" -c 'import sys; assert sys.version_info >= (3, 11)' 2>/dev/null ||
-    { say "Python 3.11+ is required (found: $("$py" --version 2>&1))"; return 1; }
+  ensure_python || return 1
   say "installing uv $UV_VERSION into $UV_HOME (hash-checked)"
   rm -rf "$UV_HOME"
   "$py" -m venv "$UV_HOME"
@@ -77,7 +86,8 @@ ensure_venv() {
   local want
   want="$(cat "$REPO_ROOT/training/uv.lock" "$REPO_ROOT/training/pyproject.toml" | sha256sum | cut -d' ' -f1)"
   if [ -f "$TALKING_FACE_VENV/.lock-sha256" ] && [ "$(cat "$TALKING_FACE_VENV/.lock-sha256")" = "$want" ]; then return 0; fi
-  ensure_uv
+  ensure_python || return 1
+  ensure_uv || return 1
   say "syncing the Python venv at $TALKING_FACE_VENV with training/uv.lock (PyTorch is a large download the first time)"
   rm -f "$TALKING_FACE_VENV/.lock-sha256"
   # --locked: fail rather than re-resolve if the lock no longer matches pyproject.toml.

@@ -7,9 +7,10 @@
  *   const live = await engine.listen(await openMicrophone(), (first, frames) => draw(frames));
  */
 export { TalkingFaceEngine, StreamSession, EngineDisposedError } from './engine/engine';
+export { DEFAULT_CHUNK_FRAMES } from './engine/pipeline';
 export type { Backend, EngineOptions, AnimateOptions, Animation, Frames, StageTimes } from './engine/engine';
 export { LiveSession, type LiveOptions } from './engine/live';
-export { decodeAudio, levels, AudioDecodeError, type DecodedAudio } from './audio/decode';
+export { decodeAudio, levels, AudioDecodeError, SILENT_PEAK, type DecodedAudio } from './audio/decode';
 export { openMicrophone, AudioCapture, StreamResampler, MicrophoneError, type CaptureOptions } from './audio/capture';
 export { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from './audio/mel';
 export { ModelLoadError, fetchManifest } from './model/artefacts';
