@@ -11,8 +11,14 @@ import { captureWorkletFile } from './scripts/worklet-file.ts';
  * dist/ort/ it uses: deploy lib/, models/ and ort/ side by side (docs/embedding.md). The example pages
  * (examples/) are copied to dist/examples/, with TalkingHead and its three.js in dist/examples/vendor/ for
  * examples/talkinghead.html (scripts/talkinghead-vendor.ts).
+ *
+ * `--mode npm` builds the same entry for bundlers into dist/lib/npm/ (the package's import): three.js is left to the
+ * project that installs it (a peer dependency), so a page with its own three.js scene has one copy of it, not two.
+ * dist/lib/talking-face.js keeps its own, for a page that loads it with one script tag and no bundler.
  */
-export default defineConfig({
+export default defineConfig(({ mode }) => mode === 'npm' ? forBundlers : standalone);
+
+const standalone = defineConfig({
   // Relative: the library's workers (lib/assets/) are found beside talking-face.js wherever lib/ is deployed, not at
   // the site's root /assets/ (where only the demo's build put copies of them).
   base: './',
@@ -41,4 +47,20 @@ export default defineConfig({
     },
   ],
   resolve: { conditions: ['onnxruntime-web-use-extern-wasm', ...defaultClientConditions] },
+});
+
+const forBundlers = defineConfig({
+  base: './',
+  publicDir: false,
+  build: {
+    outDir: 'dist/lib/npm',
+    emptyOutDir: true,
+    target: 'es2022',
+    sourcemap: true,
+    chunkSizeWarningLimit: 1024,
+    lib: { entry: resolve(import.meta.dirname, 'src/component/index.ts'), formats: ['es'], fileName: () => 'talking-face.js' },
+    rollupOptions: { external: [/^three($|\/)/] },
+  },
+  plugins: [captureWorkletFile()],
+  resolve: standalone.resolve,
 });

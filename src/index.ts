@@ -15,6 +15,7 @@ export { openMicrophone, AudioCapture, StreamResampler, MicrophoneError, type Ca
 export { logMel, logMelFrames, logMelFramesMeyda, melFrameCount } from './audio/mel';
 export { ModelLoadError, fetchManifest } from './model/artefacts';
 export type { ExecutionProvider } from './encoders/onnx-model';
+export { setRuntimeBase } from './encoders/ort-worker-client';
 export { checkManifest, frameToMelIndex, DEFAULT_MANIFEST_URL, type Manifest } from './model/manifest';
 export { ReferenceDecoder, decoderWeights, type DecoderWeights, type DecodeResult } from './attention/reference';
 export { applyPose } from './pose/posing';

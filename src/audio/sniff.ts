@@ -39,7 +39,12 @@ export function undecodableReason(bytes: ArrayBuffer): string | null {
   for (const [what, magic] of NOT_AUDIO) if (magic.every((x, i) => b[i] === x)) return `it is ${what}, not audio`;
   if (ascii(b, 0, 4) === 'RIFF' && ascii(b, 8, 4) === 'WAVE') return wavReason(new DataView(bytes));
   if (ascii(b, 0, 4) === 'FORM' && /^AIF[FC]$/.test(ascii(b, 8, 4))) return `it is an AIFF file, which this browser cannot decode: ${CONVERT}`;
-  if (looksLikeText(b)) return 'it is a text file, not audio';
+  if (looksLikeText(b)) {
+    // A URL that is not there often brings the site's index page (a host's fallback), not an error.
+    return /^\s*<(!doctype html|html|head|body)/i.test(ascii(b, 0, Math.min(b.length, 200)))
+      ? 'it is an HTML page, not audio (a wrong URL, which the site answered with a page?)'
+      : 'it is a text file, not audio';
+  }
   return null;
 }
 

@@ -6,7 +6,9 @@ export * from '../index';
 export { TalkingFaceElement, DEFAULT_MODEL, type ReadyDetail, type FrameDetail, type TalkingFaceErrorDetail } from './talking-face';
 export { TalkingFaceError, type TalkingFaceEventMap } from './events';
 
+/** Define the element under `name` (importing the library defines `talking-face`); nothing where there is no DOM. */
 export function defineTalkingFace(name = 'talking-face'): void {
+  if (typeof customElements === 'undefined') return; // a server rendering the page: the browser defines it
   if (!customElements.get(name)) customElements.define(name, name === 'talking-face' ? TalkingFaceElement : class extends TalkingFaceElement {});
 }
 

@@ -27,7 +27,10 @@ export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events'
 /** The model an element loads when it has no `model` attribute. */
 export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 
-export class TalkingFaceElement extends HTMLElement {
+/** Where there is no DOM (a framework rendering on its server imports the library there) the element is a plain class. */
+const ElementBase = (typeof HTMLElement === 'undefined' ? class {} : HTMLElement) as typeof HTMLElement;
+
+export class TalkingFaceElement extends ElementBase {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
 
   private readonly statusLine: HTMLParagraphElement;

@@ -12,7 +12,7 @@
 import type * as Ort from 'onnxruntime-web';
 import { ModelLoadError } from '../model/artefacts';
 import { STALL_SECONDS } from '../model/fetch-body';
-import { fetchRuntime } from './ort-runtime';
+import { fetchRuntime, runtimeMissing } from './ort-runtime';
 import { checkFeeds, type ExecutionProvider, type Feeds, type SessionSpec } from './onnx-spec';
 import { getRuntimeStallSeconds, markRequested, ortRoot, ortThreads, OrtWorker, sessionOptions, setRuntimeStallSeconds, WorkerRunner, type Outputs, type Runner } from './ort-worker-client';
 export { sessionsRequested } from './ort-worker-client';
@@ -49,7 +49,7 @@ export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     const root = `${ortRoot()}${ort.env.versions.web}/`;
     ort.env.wasm.wasmPaths = root;
     ort.env.wasm.wasmBinary = await fetchRuntime(root, getRuntimeStallSeconds(), build).catch((e: Error) => {
-      throw new ModelLoadError(`onnxruntime's runtime ${e.message}; reload or try again`);
+      throw new ModelLoadError(`onnxruntime's runtime ${e.message}${runtimeMissing(e.message) ? '' : '; reload or try again'}`);
     });
     return ort;
   }).catch((e: unknown) => {
@@ -149,7 +149,7 @@ export class OnnxModel {
         const why = (e as Error).message.split('\n')[0];
         const error = new ModelLoadError(/unsafe-eval|Content Security Policy/i.test(why)
           ? `the page's Content-Security-Policy does not let onnxruntime compile its WebAssembly: add 'wasm-unsafe-eval' to its script-src (${why})`
-          : `onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}) could not be loaded; reload or try again (${why})`);
+          : `onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}<version>/) could not be loaded${runtimeMissing(why) ? '' : '; reload or try again'} (${why})`);
         OrtWorker.discard(worker, error);
         throw error;
       }

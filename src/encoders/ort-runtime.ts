@@ -18,6 +18,15 @@ export async function fetchRuntime(root: string, stallSeconds: number, build: ke
   const r = await fetchBody(url, { stallSeconds }).catch((e: Error) => {
     throw failed(e.message);
   });
-  if (!r.ok) throw failed(`HTTP ${r.status}`);
-  return new Uint8Array(r.bytes);
+  const elsewhere = `serve the build's ort/ folder (dist/ort) there, or tell the library where it is: setRuntimeBase(url)`;
+  if (!r.ok) throw failed(r.status === 404 ? `HTTP 404, not there: ${elsewhere}` : `HTTP ${r.status}`);
+  const bytes = new Uint8Array(r.bytes);
+  // Every WebAssembly module begins with \0asm; a host that answers a missing file with its index page sends HTML.
+  if (!(bytes[0] === 0 && bytes[1] === 0x61 && bytes[2] === 0x73 && bytes[3] === 0x6d)) {
+    throw failed(`what came back is not WebAssembly${bytes[0] === 0x3c ? ' but an HTML page, as a host sends for a missing file' : ''}: ${elsewhere}`);
+  }
+  return bytes;
 }
+
+/** Whether a runtime download failed for good (not there), where trying again would not help. */
+export const runtimeMissing = (message: string): boolean => message.includes('setRuntimeBase(');

@@ -14,10 +14,33 @@ import type { ExecutionProvider, Feeds, SessionSpec } from './onnx-spec';
  * (docs/embedding.md).
  */
 export function ortRoot(): string {
+  if (runtimeBase) return runtimeBase;
   const sibling = '../ort/'; // (a variable: Vite would turn a literal in new URL() into a glob of assets)
   return import.meta.env.DEV
-    ? new URL(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///').href
-    : new URL(sibling, import.meta.url).href;
+    ? folderUrl(`${import.meta.env.BASE_URL}ort/`, globalThis.location?.href ?? 'file:///')
+    : folderUrl(sibling, import.meta.url);
+}
+
+let runtimeBase: string | null = null;
+
+/**
+ * Where onnxruntime's runtime (the `ort/` folder of the build: `<version>/` in it) is served, for a page whose bundler
+ * moved the library's code away from it (a project that installs the package and bundles it: Vite, webpack, a
+ * framework); relative URLs are resolved against the page. Call it before the first model loads; null goes back to
+ * the default, the `ort/` beside the folder that holds the library's code.
+ */
+export function setRuntimeBase(url: string | URL | null): void {
+  runtimeBase = url === null ? null : folderUrl(String(url), globalThis.location?.href ?? 'file:///');
+}
+
+/**
+ * `path` resolved against `base`, as a folder: ending in a slash. A consumer's Vite dev server rewrites the library's
+ * `new URL('../ort/', import.meta.url)` to `new URL('/node_modules/talking-face/dist/ort', ...)`, without the slash,
+ * and the runtime's files were then looked for at `.../dist/ort1.30.0/`.
+ */
+export function folderUrl(path: string, base: string): string {
+  const href = new URL(path, base).href;
+  return href.endsWith('/') ? href : `${href}/`;
 }
 
 /** onnxruntime's threads: up to 4 where the page is cross-origin isolated (SharedArrayBuffer) and has workers, else 1. */

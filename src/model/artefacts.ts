@@ -52,8 +52,12 @@ export async function fetchManifest(url: string | URL | undefined, fetchFn: type
     throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}`);
   });
   if (!body.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${body.status}`);
+  const text = new TextDecoder().decode(body.bytes);
+  if (/^\s*</.test(text)) {
+    throw new ModelLoadError(`the model manifest ${manifestUrl} is an HTML page, not the manifest: no manifest.json there (hosts send their index page for a missing file); serve the build's models/ folder there, or give the model's URL (the element's model attribute)`);
+  }
   try {
-    return { manifest: checkManifest(JSON.parse(new TextDecoder().decode(body.bytes))), manifestUrl };
+    return { manifest: checkManifest(JSON.parse(text)), manifestUrl };
   } catch (e) {
     throw new ModelLoadError(`the model manifest ${manifestUrl} is unreadable: ${(e as Error).message}`);
   }

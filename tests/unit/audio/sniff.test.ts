@@ -54,6 +54,7 @@ describe('undecodableReason', () => {
     expect(undecodableReason(bytes(0xff, 0xd8, 0xff, 0xe0))).toBe('it is a JPEG image, not audio');
     expect(undecodableReason(bytes(0x25, 0x50, 0x44, 0x46))).toBe('it is a PDF document, not audio');
     expect(undecodableReason(new TextEncoder().encode('Lines of notes,\nnot a recording. Ünïcödé\t😀'.repeat(200)).buffer)).toBe('it is a text file, not audio');
+    expect(undecodableReason(new TextEncoder().encode('<!DOCTYPE html>\n<html><body>app</body></html>').buffer)).toBe('it is an HTML page, not audio (a wrong URL, which the site answered with a page?)');
   });
 
   it('says nothing where the first bytes do not tell (the browser\'s reason is then given)', () => {

@@ -2,7 +2,7 @@
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { describe, expect, it } from 'vitest';
-import { fetchArtefacts, ModelLoadError } from '../../../src/model/artefacts';
+import { fetchArtefacts, fetchManifest, ModelLoadError } from '../../../src/model/artefacts';
 import { checkManifest, ManifestError } from '../../../src/model/manifest';
 
 const MODELS = resolve(import.meta.dirname, '../../../models');
@@ -77,5 +77,12 @@ describe('a stalled download', () => {
     const slow = await fetchArtefacts({ manifestUrl, fetch: stalling(file, true), stallSeconds: 0.15 });
     expect((await slow.files.hierarchical).byteLength).toBeGreaterThan(1000); // 8 pieces 20 ms apart: 160 ms in all
     await Promise.allSettled([slow.template, ...Object.values(slow.files)]);
+  });
+});
+
+describe('fetchManifest of a wrong URL', () => {
+  it('says an HTML page came back instead of the manifest, as hosts answer a missing file', async () => {
+    const page = (async () => new Response('<!doctype html><html><body>app</body></html>')) as typeof fetch;
+    await expect(fetchManifest('http://test/models/manifest.json', page)).rejects.toThrow(/is an HTML page, not the manifest: no manifest\.json there/);
   });
 });
