@@ -1,0 +1,58 @@
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { test, expect } from '@playwright/test';
+
+/**
+ * The package as another project installs it (package.json `files` and `exports`, vite.lib.config.ts `--mode npm`,
+ * scripts/dts-extensions.ts), on the build the suite serves: what `npm pack` puts in it, an import where there is no
+ * DOM, three.js left to the project, and the declarations under node16 resolution. The package imports itself by
+ * name from inside its folder (Node's self-reference through `exports`), as a project that installed it would.
+ */
+const ROOT = resolve(import.meta.dirname, '../..');
+const run = (cmd: string, args: string[], cwd = ROOT) => execFileSync(cmd, args, { cwd, encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] });
+
+test('npm pack holds the library, its declarations, the runtime and the model, and no training files', () => {
+  test.setTimeout(120_000);
+  const [pack] = JSON.parse(run('npm', ['pack', '--dry-run', '--json', '--ignore-scripts'])) as { files: { path: string }[] }[];
+  const files = new Set(pack.files.map((f) => f.path));
+  const exported = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')).exports as Record<string, Record<string, string>>;
+  for (const entry of Object.values(exported)) for (const target of Object.values(entry)) expect(files, target).toContain(target.replace(/^\.\//, ''));
+  const manifest = JSON.parse(readFileSync(join(ROOT, 'dist/models/manifest.json'), 'utf8')) as { files: Record<string, string>; runtime_files: string[] };
+  for (const key of manifest.runtime_files) expect(files, manifest.files[key]).toContain(`dist/models/${manifest.files[key]}`);
+  expect([...files].some((f) => f.startsWith('dist/ort/') && f.endsWith('ort-wasm-simd-threaded.wasm'))).toBe(true);
+  expect([...files].filter((f) => /checkpoint\.pt|fixtures|samples\/|^training\/|^tests\/|^src\//.test(f))).toEqual([]);
+});
+
+test('imports where there is no DOM, with three.js its importer\'s', () => {
+  const out = run('node', ['--input-type=module', '-e',
+    "const m = await import('talking-face'); console.log([typeof m.TalkingFaceEngine.load, typeof m.setRuntimeBase, String(globalThis.customElements === undefined)].join(' '))"]);
+  expect(out.trim()).toBe('function function true');
+  const code = readFileSync(join(ROOT, 'dist/lib/npm/talking-face.js'), 'utf8');
+  expect(code).toMatch(/from\s*"three"/);
+  expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
+});
+
+test('its declarations type a project that resolves modules as Node does (node16)', () => {
+  test.setTimeout(120_000);
+  const dir = mkdtempSync(join(ROOT, 'dist/consumer-'));
+  try {
+    writeFileSync(join(dir, 'use.ts'), [
+      "import 'talking-face';",
+      "import { TalkingFaceEngine, setRuntimeBase, type TalkingFaceElement } from 'talking-face';",
+      "setRuntimeBase('/ort/');",
+      "const face = document.createElement('talking-face') as TalkingFaceElement;",
+      "face.addEventListener('frame', (e) => { const n: number = e.detail.frame; console.log(n); });",
+      "export const load: typeof TalkingFaceEngine.load = TalkingFaceEngine.load;",
+    ].join('\n'));
+    writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
+      target: 'es2022', module: 'node16', moduleResolution: 'node16', strict: true, noEmit: true, lib: ['es2022', 'dom', 'dom.iterable'], types: [],
+    }, files: ['use.ts'] }));
+    const tsc = join(ROOT, 'node_modules/.bin/tsc');
+    let errors = '';
+    try { run(tsc, ['-p', dir]); } catch (e) { errors = String((e as { stdout?: string }).stdout ?? e); }
+    expect(errors).toBe('');
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
