@@ -272,9 +272,11 @@ async function addCaptureModule(context: AudioContext): Promise<void> {
   try {
     await context.audioWorklet.addModule(url);
   } catch (fromBlob) {
-    await context.audioWorklet.addModule(new URL(WORKLET_FILE, import.meta.url).href).catch((e: Error) => {
+    const file = new URL(WORKLET_FILE, import.meta.url).href;
+    await context.audioWorklet.addModule(file).catch((e: Error) => {
       throw new Error(`the audio capture could not be loaded (${(fromBlob as Error).message}; from the library's files: ${e.message}): ` +
-        'a Content-Security-Policy must allow the page\'s own scripts (script-src \'self\')');
+        `a Content-Security-Policy must allow blob: or the page's own scripts (script-src 'self'), and ${file} must be served ` +
+        '(a bundler does not copy it: copy the package\'s dist/lib/npm/capture-worklet.js there)');
     });
   } finally {
     URL.revokeObjectURL(url);
