@@ -26,11 +26,13 @@ export function decoderDetails(e: TalkingFaceEngine): string {
 
 /**
  * A take's figures (no speed figure for a very short clip: its few frames measure start-up, not speed; nor for a
- * silent one, which the model is not run on: engine.animateSpeech) and notes.
+ * silent one, which the model is not run on: engine.animateSpeech; nor for a recording whose live frames were kept
+ * with some held, which were not all computed) and notes.
  */
 export function takeDetails(t: Take, notes: string[]): string {
   const speed = levels(t.samples).peak < SILENT_PEAK ? 'not run on silent audio' : t.seconds < SHORT_CLIP_SECONDS
-    ? 'no speed figure for a clip this short'
+    ? 'no speed figure for a clip this short' : t.heldFrames
+    ? `no speed figure: the live frames were kept, ${t.heldFrames} of them held where the device fell behind`
     : `${(t.computeMs / t.animation.frames).toFixed(1)} ms per frame, ${(t.seconds / (t.computeMs / 1000)).toFixed(1)}x real time`;
   return `${isolated(t.name)}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
 }

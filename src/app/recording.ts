@@ -69,8 +69,8 @@ export class Recording {
     if (samples.length < rate / 10) return null;
     const buffer = new AudioBuffer({ length: samples.length, sampleRate: rate, numberOfChannels: 1 });
     buffer.copyToChannel(new Float32Array(samples), 0);
-    const t = e.times;
-    const computeMs = t.mel + t.content + t.hierarchical + t.pose + t.decoder + t.posing;
+    const spent = () => Object.values(e.times).reduce((sum: number, ms: number) => sum + ms, 0);
+    let computeMs = spent(); // the live stream's
     const total = e.frameCount(samples.length);
     const streamed = this.frames.reduce((s, c) => s + c.frames.count, 0);
     if (this.live.stream.skippedFrames === 0 && streamed === total)
@@ -79,7 +79,9 @@ export class Recording {
     let animation: Animation, heldFrames = 0;
     onReanimate(0, total);
     try {
+      e.resetTimes();
       animation = await e.animate(samples, { unposed: true, signal, onProgress: onReanimate });
+      computeMs = spent(); // the whole take's, once: what its speed figure is of
     } catch (err) {
       if (!signal?.aborted || streamed === 0) throw err; // (no live frame to keep)
       [animation, heldFrames] = [placeFrames(this.frames, total, e.fps), total - streamed]; // (not made before: a long take's frames are large)

@@ -22,6 +22,8 @@ export interface Take {
   name: string;
   seconds: number;
   computeMs: number;
+  /** A recording's frames that hold the one before them (skipped live, their animation cancelled): no speed figure. */
+  heldFrames?: number;
   backend: Backend;
   truth?: Truth;
   /** E_vl of the whole take against its ground truth (mm), computed once. */
