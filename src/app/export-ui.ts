@@ -4,7 +4,7 @@ import type { FaceTemplate } from '../template/face-template';
 import { exportGlb, rawFrames, download, GLB_EXACT_FRAMES } from './export-glb';
 import { showStatus, tell, ui } from './controls';
 import { fileBaseName, isolated } from './names';
-import { PlaybackStopped, recordTake, videoType } from './export-video';
+import { PlaybackStopped, recordTake, videoType } from '../player/record-video';
 import type { Player } from '../player/player';
 
 /** The .glb or video being prepared (a long clip's takes seconds, a video as long as the take): Escape cancels it (cancelExport). */
@@ -56,7 +56,7 @@ export function exportRawFile(animation: Animation, name: string, template: Face
   ui.exportInfo.textContent = (`Exported ${animation.frames} frames x ${n} vertices x 3 as float32 (little-endian, ${template.units}, ${animation.fps} fps).`);
 }
 
-/** Record the take playing, with its sound, and save it (export-video.ts); the button again or Escape cancels. */
+/** Record the take playing, with its sound, and save it (player/record-video.ts); the button again or Escape cancels. */
 export async function exportVideoFile(view: { recording: boolean }, player: Player, fps: number, name: string): Promise<void> {
   if (exporting) {
     if (ui.exportVideoButton.getAttribute('aria-busy')) exporting.abort(); // the button again: cancel

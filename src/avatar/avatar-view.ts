@@ -28,6 +28,7 @@ export class AvatarView {
   readonly controls: OrbitControls;
   private readonly resizeObserver: ResizeObserver;
   private readonly onScreen: OnScreen;
+  recording = false; // draw even while out of sight (a recording of the canvas needs its frames: player/record-video.ts)
   private needsRender = true;
   private frameHandle = 0;
   private readonly blinks = new Blinks(performance.now());
@@ -173,7 +174,7 @@ export class AvatarView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
-    if (!this.onScreen.shown) return;
+    if (!this.onScreen.shown && !this.recording) return;
     if (this.controls.update()) this.needsRender = true;
     if (this.speech !== this.target) this.ramp(performance.now() / 1000);
     const blink = this.avatar.canBlink && !this.reducedMotion?.matches ? this.blinks.at(performance.now()) : 0;

@@ -52,3 +52,9 @@ export function holdEngine(model: string, template: string | null, backend: stri
     },
   };
 }
+
+/** What `work` gives, or null as soon as `signal` is aborted (stop() while the model loads: the caller then does nothing). */
+export function unlessAborted<T>(work: Promise<T>, signal: AbortSignal): Promise<T | null> {
+  const stopped = new Promise<null>((resolve) => (signal.aborted ? resolve(null) : signal.addEventListener('abort', () => resolve(null), { once: true })));
+  return Promise.race([work.catch((e: unknown) => (signal.aborted ? null : Promise.reject(e))), stopped]);
+}

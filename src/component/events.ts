@@ -80,3 +80,9 @@ export function liveFrameDetail(engine: TalkingFaceEngine, first: number, frames
     ...(frames.blendshapes && frameWeights(frames.blendshapes, last)),
   };
 }
+
+/** The `ready` event's detail for `engine`, showing `avatar` (or the model's face: undefined). */
+export function readyDetail(engine: TalkingFaceEngine, avatar: AvatarSummary | undefined): ReadyDetail {
+  return { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
+    threads: { encoders: engine.encoderThreads, decoder: engine.cpuThreads }, avatar };
+}

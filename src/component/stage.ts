@@ -9,6 +9,7 @@ import type { FaceTemplate } from '../template/face-template';
 import { Player, type PlayerOptions } from '../player/player';
 import { newCanvas } from './parts';
 import { cameraKey } from '../render/camera-keys';
+import { recordTake } from '../player/record-video';
 
 export class ElementStage {
   view: FaceView | AvatarView | null = null;
@@ -63,6 +64,12 @@ export class ElementStage {
   async settled(): Promise<Player | null> {
     await this.made.catch(() => undefined); // deliberate: a failed view has said why (`error`, and make() rejected)
     return this.player;
+  }
+
+  /** The take loaded in the player, played from its start and recorded with its sound (player/record-video.ts). */
+  recordVideo(fps: number, signal: AbortSignal, onProgress: (frame: number) => void): Promise<Blob> {
+    if (!this.view || !this.player?.take) return Promise.reject(new Error('there is no take to record: speak() one first'));
+    return recordTake(this.canvas, this.view, this.player, fps, signal, onProgress);
   }
 
   /** Stop drawing and playing: the view and its player disposed, a view still loading not shown. */

@@ -5,7 +5,7 @@
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
  * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
- * avatar-head-bone, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop().
+ * avatar-head-bone, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop(), recordVideo().
  * Events: ready, frame, ended, error (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
 import { AvatarView } from '../avatar/avatar-view';
@@ -18,9 +18,9 @@ import { shadowParts } from './parts';
 import { ElementStage } from './stage';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
-import { holdEngine, type EngineHold } from './engines';
+import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { liveFrameDetail, playbackFrameDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
+import { liveFrameDetail, playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
@@ -131,7 +131,7 @@ export class TalkingFaceElement extends ElementBase {
    */
   async speak(audio: Blob | AudioBuffer | URL | string): Promise<void> {
     const { gen, signal } = this.begin();
-    const engine = await this.loadUnless(signal);
+    const engine = await unlessAborted(this.load(), signal);
     if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded
     let take: ElementTake;
     try {
@@ -163,7 +163,7 @@ export class TalkingFaceElement extends ElementBase {
   /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
   async startMicrophone(): Promise<void> {
     const { gen, signal } = this.begin();
-    const engine = await this.loadUnless(signal);
+    const engine = await unlessAborted(this.load(), signal);
     if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded: the microphone stays closed
     let media: MediaStream;
     try {
@@ -198,6 +198,17 @@ export class TalkingFaceElement extends ElementBase {
     this.live = live;
     this.work = null;
     this.setStatus(`Listening (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms, ${engine.backend})…`);
+  }
+
+  /**
+   * The last take (speak()) played from its start and recorded, with its sound, as a video (WebM, or MP4 where the browser
+   * records only that) in real time; `signal` cancels (rejecting with its reason). Otherwise rejects with a TalkingFaceError.
+   */
+  async recordVideo(options: { signal?: AbortSignal; onProgress?: (seconds: number) => void } = {}): Promise<Blob> {
+    const { engine, animation } = this;
+    if (!engine || !animation) throw this.fail('render', 'there is no take to record: speak() one first');
+    return this.stage.recordVideo(engine.fps, options.signal ?? new AbortController().signal, (f) => options.onProgress?.(f / engine.fps))
+      .catch((e: Error) => Promise.reject(options.signal?.aborted ? e : this.fail('render', `the video could not be made: ${e.message}`)));
   }
 
   /** Stop playback and the microphone; the face (or avatar) goes back to rest. */
@@ -255,12 +266,6 @@ export class TalkingFaceElement extends ElementBase {
     return this.loading;
   }
 
-  /** The engine, or null as soon as `signal` is aborted (stop() while the model loads: the caller then does nothing). */
-  private loadUnless(signal: AbortSignal): Promise<TalkingFaceEngine | null> {
-    const stopped = new Promise<null>((resolve) => (signal.aborted ? resolve(null) : signal.addEventListener('abort', () => resolve(null), { once: true })));
-    return Promise.race([this.load().catch((e: unknown) => (signal.aborted ? null : Promise.reject(e))), stopped]);
-  }
-
   /** Release the engine (another load takes one anew). */
   private letGo(): void {
     this.hold?.release();
@@ -291,10 +296,7 @@ export class TalkingFaceElement extends ElementBase {
       : engine.restFace().then((r) => (view as PlayerView | null)?.setRestFace?.(r));
     rest.catch((e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`));
     this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
-    this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', {
-      detail: { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
-        threads: { encoders: engine.encoderThreads, decoder: engine.cpuThreads }, avatar: this.avatar?.summary },
-    }));
+    this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', { detail: readyDetail(engine, this.avatar?.summary) }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (!start) return;

@@ -275,7 +275,7 @@ export class Player {
     void this.context.resume().catch(() => undefined); // rejects only on a closed context; play() then says why
   }
 
-  /** The sound of what plays from now on as a stream too (a recording of the take: app/export-video.ts), until untap(). */
+  /** The sound of what plays from now on as a stream too (a recording of the take: player/record-video.ts), until untap(). */
   tap(): MediaStream {
     this.context ??= new AudioContext();
     this.tapNode ??= this.context.createMediaStreamDestination();

@@ -67,7 +67,7 @@ export class FaceView {
   private speech = 1;
   private speechTarget = 1;
   private tongue = 0;
-  recording = false; // draw even while out of sight (a recording of the canvas needs its frames: app/export-video.ts)
+  recording = false; // draw even while out of sight (a recording of the canvas needs its frames: player/record-video.ts)
   private readonly pose = new Float32Array(6);
   private readonly resizeObserver: ResizeObserver;
   private readonly onScreen: OnScreen;

@@ -1,5 +1,5 @@
 /**
- * The take as a video to share: the face's canvas as it plays the take from the start, with the take's sound,
+ * The take as a video to share (the demo's Export video, the element's recordVideo()): the face's canvas as it plays the take from the start, with the take's sound,
  * recorded by the browser (MediaRecorder: WebM with VP9 or VP8 and Opus, or MP4 where a browser records only that).
  * It records in real time, so it takes as long as the take (and half a second more, for the face to go back to
  * rest); what the face's canvas shows is what is recorded (pose arrows, colours, the idle life; not the ground
@@ -7,7 +7,7 @@
  * MediaRecorder writes it): players learn the length as they play it. Nothing leaves the page: the file is made
  * in the browser and saved by the visitor.
  */
-import type { Player } from '../player/player';
+import type { Player } from './player';
 
 /** Containers and codecs tried in order (the first the browser records is used). */
 export const VIDEO_TYPES = ['video/webm;codecs=vp9,opus', 'video/webm;codecs=vp8,opus', 'video/webm', 'video/mp4'];
