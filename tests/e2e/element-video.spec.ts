@@ -23,7 +23,7 @@ test('the element records its last take as a video with its sound; before a take
   const read = await face.evaluate(async (el) => {
     const f = el as FaceEl;
     const errors: string[] = [];
-    f.addEventListener('error', (e) => errors.push((e as CustomEvent).detail.message));
+    f.addEventListener('error', (e) => errors.push((e as unknown as CustomEvent<{ message: string }>).detail.message));
     let progress = 0;
     const blob = await f.recordVideo({ onProgress: (s) => (progress = s) });
     const data = new Uint8Array(await blob.arrayBuffer());
