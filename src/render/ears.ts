@@ -23,11 +23,24 @@ const smooth = (a: number, b: number, x: number) => {
   return t * t * (3 - 2 * t);
 };
 
+/** Where an ear sits on a head: its middle's height and depth, its height and width (template units). */
+export interface EarPlace {
+  y: number;
+  z: number;
+  height: number;
+  width: number;
+}
+
+export function earPlace(m: FaceMeasures, egg: Egg): EarPlace {
+  const H = m.top - m.chin;
+  return { y: m.eyeY - 0.11 * H, z: egg.center[2] - 0.09 * H, height: 0.34 * H, width: 0.19 * H };
+}
+
 /** The two ears for a head (the subject's right, at -x, first), skin-coloured (`skin`: the skin's colour). */
 export function earGeometries(m: FaceMeasures, egg: Egg, skin: THREE.Color): THREE.BufferGeometry[] {
   const H = m.top - m.chin;
-  const h = 0.34 * H, w = 0.19 * H, t = 0.045 * H; // height, width, the rim's thickness
-  const cy = m.eyeY - 0.11 * H, cz = egg.center[2] - 0.09 * H;
+  const { y: cy, z: cz, height: h, width: w } = earPlace(m, egg);
+  const t = 0.045 * H; // the rim's thickness
   // Where the egg's surface is at the ear's middle (its superellipsoid).
   const uy = Math.abs(cy - egg.center[1]) / (cy >= egg.center[1] ? egg.up : egg.down);
   const uz = Math.abs(cz - egg.center[2]) / (cz >= egg.center[2] ? egg.front : egg.back);

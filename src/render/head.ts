@@ -15,7 +15,7 @@ import { headShell, faceMeasures, ovalLoop, type HeadShell, type FaceMeasures } 
 import { JawEstimator, jawHinge, turnAboutHinge, type Hinge } from './jaw';
 import { mouthBag, mouthFrame, teethGeometry, tongueGeometry, updateBag, type MouthBag } from './mouth-interior';
 import { Eyes, eyeSkirts, updateSkirts, type EyeSkirts } from './eyes';
-import { earGeometries } from './ears';
+import { earGeometries, earPlace } from './ears';
 import { PartialNormals } from './normals';
 import { SKIN, cavityMaterial, clothMaterial, eyeCornerMaterial, headColors, skinMaterial, teethMaterial, tongueMaterial } from './materials';
 
@@ -77,7 +77,7 @@ export class Head {
     this.positions.setUsage(THREE.DynamicDrawUsage);
     geometry.setAttribute('position', this.positions);
     this.colors = new Float32Array(all.length);
-    this.colors.set(headColors(t, this.shell?.positions ?? null, this.shell?.egg ?? null));
+    this.colors.set(headColors(t, this.shell?.positions ?? null, this.shell?.egg ?? null, this.shell ? earPlace(m, this.shell.egg) : null));
     geometry.setAttribute('color', new THREE.BufferAttribute(this.colors.slice(), 3));
     const skinTris = this.shell ? [...t.triangles, ...this.shell.triangles] : [...t.triangles];
     const bagTris = this.bag ? [...this.bag.triangles] : [];

@@ -13,6 +13,7 @@
 import * as THREE from 'three';
 import { studioEnvironment } from './environment';
 import { lipMask, type FaceTemplate } from '../template/face-template';
+import type { EarPlace } from './ears';
 
 export const BACKGROUND = 0x1d2230;
 export const SKIN = new THREE.Color(0xcc9c84);
@@ -86,7 +87,8 @@ export function eyeMaterial(): THREE.MeshPhysicalMaterial {
  * Per-vertex colours of the joined face + shell buffer: skin with warmer cheeks, lips, and hair on the shell's
  * crown and back (shell vertices above the brows, lower at the back of the head).
  */
-export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { center: number[]; up: number; back: number } | null): Float32Array {
+export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { center: number[]; ax: number; up: number; back: number } | null,
+  ear: EarPlace | null = null): Float32Array {
   const n = t.vertexCount;
   const s = shell ? shell.length / 3 : 0;
   const colors = new Float32Array((n + s) * 3);
@@ -112,7 +114,11 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
       const line = z > 0 ? egg.up * (0.1 + 0.4 * Math.min(1, z / (0.4 * egg.back))) : egg.up * (0.1 - 1.0 * back * back);
       // A transition two or three of the shell's rings wide, eased: a sharper one shows their triangles as a sawtooth.
       const f = Math.min(1, Math.max(0, (y - line) / (0.3 * egg.up) + 0.25));
-      const h = f * f * (3 - 2 * f);
+      // Skin round each ear (a margin of about half its size), as hair grows above and behind it, not up to it.
+      const e = ear && Math.abs(shell[3 * i] - egg.center[0]) > 0.5 * egg.ax
+        ? Math.hypot((shell[3 * i + 1] - ear.y) / ear.height, (shell[3 * i + 2] - ear.z) / ear.width) : Infinity;
+      const bare = Math.min(1, Math.max(0, (0.85 - e) / 0.3));
+      const h = f * f * (3 - 2 * f) * (1 - bare * bare * (3 - 2 * bare));
       c.copy(SKIN).lerp(HAIR, h).toArray(colors, 3 * (n + i));
     }
   }
