@@ -23,9 +23,20 @@ const HAIR = new THREE.Color(0x2b1d16);
 
 export function skinMaterial(): THREE.MeshStandardMaterial {
   // A little specular (oily skin) and a warm emissive floor for light scattered under the skin.
-  return new THREE.MeshStandardMaterial({
+  const skin = new THREE.MeshStandardMaterial({
     name: 'skin', vertexColors: true, roughness: 0.6, metalness: 0, emissive: 0x1c0804,
   });
+  skin.onBeforeCompile = mattHair;
+  return skin;
+}
+
+/**
+ * Hair (the darkest vertex colours) is matt: with the skin's sheen the rim light made a pale patch on the crown. The
+ * cloth has it too (its vertex colours are white, so nothing changes there) to share the skin's shader program.
+ */
+function mattHair(shader: { fragmentShader: string }): void {
+  shader.fragmentShader = shader.fragmentShader.replace('#include <roughnessmap_fragment>',
+    '#include <roughnessmap_fragment>\n\troughnessFactor = mix(0.95, roughnessFactor, smoothstep(0.03, 0.09, dot(vColor.rgb, vec3(1.0 / 3.0))));');
 }
 
 /** Give the materials under `root` that reflect (eyes, teeth, tongue) the environment map. */
@@ -67,9 +78,9 @@ export function tongueMaterial(): THREE.MeshStandardMaterial {
 }
 
 export function clothMaterial(): THREE.MeshStandardMaterial {
-  // White vertex colours (head.ts), read like the skin's: three.js then draws the cloth with the skin's shader
-  // program, and the first draw links one program fewer (under a software GPU each costs tens of ms; issue 18).
-  return new THREE.MeshStandardMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85, vertexColors: true });
+  // White vertex colours (head.ts), read like the skin's, and the skin's shader change: three.js then draws the cloth
+  // with the skin's shader program, and the first draw links one program fewer (under a software GPU each costs tens of ms; issue 18).
+  return Object.assign(new THREE.MeshStandardMaterial({ name: 'cloth', color: 0x37475e, roughness: 0.85, vertexColors: true }), { onBeforeCompile: mattHair });
 }
 
 /**
