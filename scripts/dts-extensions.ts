@@ -7,6 +7,7 @@
  */
 import { existsSync, readdirSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
 
 /** `source` (a .d.ts in `dir`) with each relative module specifier naming its file, as `exists` finds them. */
 export function withExtensions(source: string, dir: string, exists: (path: string) => boolean = existsSync): string {
@@ -27,7 +28,7 @@ function* declarations(dir: string): Generator<string> {
   }
 }
 
-if (import.meta.url === `file://${process.argv[1]}`) {
+if (process.argv[1] && fileURLToPath(import.meta.url) === resolve(process.argv[1])) {
   const root = process.argv[2];
   if (!root || !existsSync(root)) {
     console.error('usage: tsx scripts/dts-extensions.ts DIR   (the declarations tsc wrote, e.g. dist/lib/types)');

@@ -78,6 +78,7 @@ export class Head {
     geometry.setAttribute('position', this.positions);
     this.colors = new Float32Array(all.length);
     this.colors.set(headColors(t, this.shell?.positions ?? null, this.shell?.egg ?? null, this.shell ? earPlace(m, this.shell.egg) : null));
+    this.colors.fill(1, (this.n + S) * 3); // the cavity and the skirts: white, so a .glb viewer shows their materials' colours
     geometry.setAttribute('color', new THREE.BufferAttribute(this.colors.slice(), 3));
     const skinTris = this.shell ? [...t.triangles, ...this.shell.triangles] : [...t.triangles];
     const bagTris = this.bag ? [...this.bag.triangles] : [];
