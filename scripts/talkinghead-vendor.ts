@@ -9,6 +9,8 @@
  *   vendor/talkinghead/modules/talkinghead.mjs, dynamicbones.mjs, lipsync-*.mjs, playback-worklet.js, LICENSE
  *   vendor/three/build/three.module.js, three.core.js, LICENSE
  *   vendor/three/examples/jsm/loaders/GLTFLoader.js, ... (the addons' own layout: they import each other relatively)
+ *
+ * The project's own three.js goes beside it (vendorProjectThree), for examples/own-scene.html: vendor/three-project/.
  */
 import { cpSync, existsSync, mkdirSync, readFileSync, readdirSync } from 'node:fs';
 import { createRequire } from 'node:module';
@@ -44,27 +46,44 @@ function importsOf(file: string): string[] {
 export function vendorTalkingHead(vendorDir: string): string[] {
   const { talkinghead, three } = talkingHeadPackages();
   const copied: string[] = [];
-  const copy = (from: string, to: string) => {
-    mkdirSync(dirname(to), { recursive: true });
-    cpSync(from, to, { preserveTimestamps: true });
-    copied.push(relative(vendorDir, to));
-  };
   const modules = join(talkinghead, 'modules');
-  for (const f of readdirSync(modules)) copy(join(modules, f), join(vendorDir, 'talkinghead/modules', f));
-  copy(join(talkinghead, 'LICENSE'), join(vendorDir, 'talkinghead/LICENSE'));
-  for (const f of ['build/three.module.js', 'build/three.core.js', 'LICENSE']) copy(join(three, f), join(vendorDir, 'three', f));
-
+  for (const f of readdirSync(modules)) copied.push(copyInto(vendorDir, join(modules, f), join(vendorDir, 'talkinghead/modules', f)));
+  copied.push(copyInto(vendorDir, join(talkinghead, 'LICENSE'), join(vendorDir, 'talkinghead/LICENSE')));
   // three's addons that TalkingHead's modules import, and theirs, transitively.
+  const addons = readdirSync(modules).filter((f) => f.endsWith('.mjs')).flatMap((f) => importsOf(join(modules, f)));
+  return [...copied, ...vendorThree(three, addons, vendorDir, 'three', 'TalkingHead')];
+}
+
+/**
+ * The project's own three.js (the version the library is built and tested with, its peer dependency) into
+ * `vendorDir`/three-project/, with the addons the library's sources import (static or dynamic): for
+ * examples/own-scene.html, whose import map gives the package's build for bundlers (dist/lib/npm/) this three.js.
+ */
+export function vendorProjectThree(vendorDir: string, root: string): string[] {
+  const three = dirname(dirname(createRequire(join(root, 'package.json')).resolve('three')));
+  const addons: string[] = [];
+  const walk = (dir: string) => {
+    for (const e of readdirSync(dir, { withFileTypes: true })) {
+      if (e.isDirectory()) walk(join(dir, e.name));
+      else if (e.name.endsWith('.ts')) for (const m of readFileSync(join(dir, e.name), 'utf8').matchAll(/['"](three\/addons\/[^'"]+)['"]/g)) addons.push(m[1]);
+    }
+  };
+  walk(join(root, 'src'));
+  return vendorThree(three, addons, vendorDir, 'three-project', 'the library');
+}
+
+/** three.js's build and licence from the package folder `three`, and the addons among `imports` with theirs, transitively, into `vendorDir`/`folder`/. */
+function vendorThree(three: string, imports: string[], vendorDir: string, folder: string, user: string): string[] {
+  const copied = ['build/three.module.js', 'build/three.core.js', 'LICENSE'].map((f) => copyInto(vendorDir, join(three, f), join(vendorDir, folder, f)));
   const jsm = join(three, 'examples/jsm');
-  const pending = readdirSync(modules).filter((f) => f.endsWith('.mjs')).flatMap((f) => importsOf(join(modules, f)))
-    .filter((s) => s.startsWith('three/addons/')).map((s) => join(jsm, s.slice('three/addons/'.length)));
+  const pending = imports.filter((s) => s.startsWith('three/addons/')).map((s) => join(jsm, s.slice('three/addons/'.length)));
   const seen = new Set<string>();
   while (pending.length) {
     const file = pending.pop()!;
     if (seen.has(file)) continue;
     seen.add(file);
-    if (!existsSync(file)) throw new Error(`TalkingHead imports ${relative(three, file)}, which three.js at ${three} does not have`);
-    copy(file, join(vendorDir, 'three/examples/jsm', relative(jsm, file)));
+    if (!existsSync(file)) throw new Error(`${user} imports ${relative(three, file)}, which three.js at ${three} does not have`);
+    copied.push(copyInto(vendorDir, file, join(vendorDir, folder, 'examples/jsm', relative(jsm, file))));
     for (const s of importsOf(file)) {
       if (s.startsWith('.')) pending.push(resolve(dirname(file), s));
       else if (s.startsWith('three/addons/')) pending.push(join(jsm, s.slice('three/addons/'.length)));
@@ -72,4 +91,11 @@ export function vendorTalkingHead(vendorDir: string): string[] {
     }
   }
   return copied;
+}
+
+/** Copy one file (its folder made); returns its path relative to `vendorDir`. */
+function copyInto(vendorDir: string, from: string, to: string): string {
+  mkdirSync(dirname(to), { recursive: true });
+  cpSync(from, to, { preserveTimestamps: true });
+  return relative(vendorDir, to);
 }

@@ -29,6 +29,8 @@ export { BlendshapeSolver, type SolverOptions, type SolverState } from './avatar
 export { AvatarWeights, frameWeights, yawPitchRoll, type BlendshapeFrames, type FrameWeights } from './avatar/weights';
 export { VisemeMap, PHONE_TO_VISEME } from './avatar/visemes';
 export { GltfAvatar, AvatarLoadError, type AvatarSummary } from './avatar/gltf-avatar';
+export { AvatarDriver, BLEND_IN_SECONDS, BLEND_OUT_SECONDS, type DrivenFrames } from './avatar/avatar-driver';
+export { Blinks } from './avatar/blinks';
 export { blendshapesJson, liveLinkFaceCsv, liveLinkTimecode, blendshapesGlb } from './avatar/export';
 export { TalkingHeadDriver, talkingHeadAnim, talkingHeadAngles, TALKINGHEAD_SHAPES, TALKINGHEAD_HEAD, type TalkingHeadLike, type TalkingHeadOptions } from './avatar/talkinghead';
 export { avatarScene, visemeAsArkit, buildAvatarGlb } from './avatar/avatar-mesh';

@@ -32,8 +32,6 @@ export interface AvatarSummary {
 
 export class GltfAvatar {
   private readonly rest = new THREE.Quaternion();
-  private readonly parentWorld = new THREE.Quaternion();
-  private readonly parentInverse = new THREE.Quaternion();
 
   /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
   private readonly modelBlink = [0, 0];
@@ -48,12 +46,7 @@ export class GltfAvatar {
     /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
     private readonly blinkTargets: Target[],
   ) {
-    if (head) {
-      gltf.scene.updateMatrixWorld(true);
-      this.rest.copy(head.quaternion);
-      head.parent?.getWorldQuaternion(this.parentWorld);
-      this.parentInverse.copy(this.parentWorld).invert();
-    }
+    if (head) this.rest.copy(head.quaternion);
   }
 
   /**
@@ -148,17 +141,23 @@ export class GltfAvatar {
   }
 
   /**
-   * Turn the head bone by an axis-angle rotation (radians) given in the avatar's world axes (glTF's: +y up, the
-   * face towards +z, as the template's), about the bone's own pivot: the world rotation is carried into the
-   * bone's parent frame, then applied on top of the bone's rest rotation.
+   * Turn the head bone by an axis-angle rotation (radians) given in the avatar's own axes (glTF's: +y up, the face
+   * towards +z, as the template's), about the bone's own pivot, on top of the bone's rest rotation. The axes are
+   * gltf.scene's, wherever the page has put or turned it: the rotation is carried into the bone's parent frame
+   * through the parent's rotation relative to gltf.scene, read at each call, so an avatar placed, turned or
+   * re-parented before or after binding nods about its own x axis.
+   *
+   * `onTop`: on top of the bone's rotation as it is now, not its rest: for a page whose own animation (an
+   * AnimationMixer) sets the head bone every frame, called once per frame after it (else the turns add up).
    */
-  setHeadRotation(rx: number, ry: number, rz: number): void {
+  setHeadRotation(rx: number, ry: number, rz: number, onTop = false): void {
     if (!this.head) return;
     const angle = Math.hypot(rx, ry, rz);
     if (angle < 1e-9) scratch.identity();
     else scratch.setFromAxisAngle(axis.set(rx / angle, ry / angle, rz / angle), angle);
-    scratch.premultiply(this.parentInverse).multiply(this.parentWorld); // parent^-1 * delta * parent
-    this.head.quaternion.copy(scratch).multiply(this.rest);
+    const parent = parentInScene(this.head, this.gltf.scene);
+    scratch.premultiply(inverse.copy(parent).invert()).multiply(parent); // parent^-1 * delta * parent
+    this.head.quaternion.multiplyQuaternions(scratch, onTop ? this.head.quaternion : this.rest); // (reads both before it writes)
   }
 }
 
@@ -182,7 +181,18 @@ function folderOf(source: string): string {
 }
 
 const scratch = new THREE.Quaternion();
+const inverse = new THREE.Quaternion();
+const sceneWorld = new THREE.Quaternion();
+const parentWorld = new THREE.Quaternion();
 const axis = new THREE.Vector3();
+
+/** The rotation of the head's parent relative to the avatar's root (gltf.scene), from their world rotations now. */
+function parentInScene(head: THREE.Object3D, scene: THREE.Object3D): THREE.Quaternion {
+  if (!head.parent) return parentWorld.identity();
+  head.parent.getWorldQuaternion(parentWorld);
+  scene.getWorldQuaternion(sceneWorld);
+  return parentWorld.premultiply(sceneWorld.invert()); // scene^-1 * parent
+}
 
 /** The head bone: the named one, else a bone (or node) named Head / head, else one whose name ends in "head". */
 function findHead(scene: THREE.Object3D, source: string, name?: string | null): THREE.Object3D | null {

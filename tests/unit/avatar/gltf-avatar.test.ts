@@ -138,4 +138,26 @@ describe('GltfAvatar', () => {
     gltf.scene.updateMatrixWorld(true);
     expect(head.getWorldQuaternion(new THREE.Quaternion()).angleTo(restWorld)).toBeLessThan(1e-6);
   });
+
+  it("nods about the avatar's own x axis when the page has turned it, before binding or after", () => {
+    for (const when of ['before', 'after'] as const) {
+      const gltf = fake(['jawOpen'], ['Hips', 'Head']);
+      const hips = gltf.scene.getObjectByName('Hips')!, head = gltf.scene.getObjectByName('Head')!;
+      hips.quaternion.setFromAxisAngle(new THREE.Vector3(0, 1, 0), Math.PI / 2);
+      const world = new THREE.Group();
+      world.add(gltf.scene);
+      const turn = () => { world.rotation.y = Math.PI; gltf.scene.rotation.z = 0.4; }; // facing the page's camera, leaning
+      if (when === 'before') turn();
+      const a = GltfAvatar.bind(gltf, 'x.glb');
+      if (when === 'after') turn();
+      world.updateMatrixWorld(true);
+      const inScene = () => gltf.scene.getWorldQuaternion(new THREE.Quaternion()).invert()
+        .multiply(head.getWorldQuaternion(new THREE.Quaternion()));
+      const rest = inScene();
+      a.setHeadRotation(0.3, 0, 0); // a nod about the avatar's own x axis
+      world.updateMatrixWorld(true);
+      const want = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.3).multiply(rest);
+      expect(inScene().angleTo(want), when).toBeLessThan(1e-6);
+    }
+  });
 });

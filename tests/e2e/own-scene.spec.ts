@@ -1,0 +1,111 @@
+import { test, expect } from './fixtures';
+import { fakeMicrophone } from '../../playwright.config';
+import { SPEECH } from './helpers/audio';
+import { ARKIT_NAMES } from '../../src/avatar/names';
+
+/**
+ * examples/own-scene.html: a page with its own three.js scene (the project's three.js through its import map) loads
+ * the test avatar with its own GLTFLoader, places it turned, and has the package's build for bundlers
+ * (dist/lib/npm/, three.js external) drive it: GltfAvatar.bind + AvatarDriver, frame by frame on the audio clock, and
+ * live from a (fake) microphone. Read from the avatar itself at many instants: its morph targets are the take's
+ * weights for the frame shown and its head bone, relative to the avatar's root, is the predicted rotation on top of
+ * its rest, although the page turned the avatar. One three.js, from the page's origin; no console error (fixtures.ts).
+ */
+test.use({ launchOptions: fakeMicrophone(SPEECH) });
+
+const CHECKED = ['jawOpen', 'mouthClose', 'mouthFunnel', 'mouthRollLower', 'mouthSmileLeft'] as const;
+
+interface Sample {
+  frame: number;
+  speech: number;
+  influences: number[];
+  /** The head bone's rotation relative to gltf.scene, less its rest: [x, y, z, w]. */
+  turn: number[];
+}
+
+type Page = import('@playwright/test').Page;
+
+/** Read the avatar every ~70 ms until collect() is called again with `stop`. */
+async function sample(page: Page, names: readonly string[]) {
+  await page.evaluate((names) => {
+    const g = globalThis as any;
+    const { state, THREE } = g.ownSceneExample;
+    const avatar = state.driver.avatar, head = avatar.head, root = avatar.gltf.scene;
+    let mesh: any;
+    root.traverse((o: any) => { if (o.morphTargetInfluences) mesh = o; });
+    const restInverse = head.quaternion.clone().invert(); // sampled at rest: the head bone's own rest rotation
+    const parentInRoot = () => root.getWorldQuaternion(new THREE.Quaternion()).invert().multiply(head.parent.getWorldQuaternion(new THREE.Quaternion()));
+    g.samples = [];
+    g.sampler = setInterval(() => {
+      const p = parentInRoot();
+      // head = P^-1 D P rest  =>  D = P head rest^-1 P^-1 (the turn in the avatar's own axes)
+      const d = p.clone().multiply(head.quaternion).multiply(restInverse).multiply(p.clone().invert());
+      g.samples.push({
+        frame: state.source ? state.frame : -1,
+        speech: state.driver.speechWeight,
+        influences: names.map((n: string) => mesh.morphTargetInfluences[mesh.morphTargetDictionary[n]]),
+        turn: [d.x, d.y, d.z, d.w],
+      });
+    }, 70);
+  }, [...names]);
+}
+const collect = (page: Page): Promise<Sample[]> => page.evaluate(() => {
+  const g = globalThis as any;
+  clearInterval(g.sampler);
+  return g.samples;
+});
+
+test('an avatar in the page\'s own three.js scene speaks a take frame by frame, and what the microphone hears', async ({ page, guard }) => {
+  test.setTimeout(180_000);
+  const warnings: string[] = [];
+  page.on('console', (m) => { if (m.type() === 'warning') warnings.push(m.text()); });
+  await page.goto('/examples/own-scene.html');
+  await expect(page.locator('#log')).toHaveText(/^ready: \d+ frames of the sample/, { timeout: 150_000 });
+  // The page's three.js is the project's, from its origin, and the only one: the library did not bring its own.
+  const paths = guard.requests.map((u) => new URL(u).pathname);
+  expect(paths).toContain('/examples/vendor/three-project/build/three.module.js');
+  expect(paths).toContain('/lib/npm/talking-face.js');
+  expect(paths).not.toContain('/lib/talking-face.js');
+  expect(warnings.filter((w) => /Multiple instances of Three/.test(w))).toEqual([]);
+  expect(await page.evaluate(() => (globalThis as any).ownSceneExample.scene.getObjectByName('Head') !== undefined)).toBe(true);
+
+  const take = await page.evaluate(() => {
+    const { take } = (globalThis as any).ownSceneExample.state;
+    return { frames: take.frames as number, arkit: Array.from(take.blendshapes.arkit as Float32Array), pose: Array.from(take.pose as Float32Array) };
+  });
+
+  // 1. The take, on the audio clock.
+  await sample(page, CHECKED);
+  await page.locator('#speak').click();
+  await expect(page.locator('#log')).toHaveText(`played ${take.frames} frames`, { timeout: 30_000 });
+  const played = (await collect(page)).filter((s) => s.frame >= 0 && s.speech === 1);
+  expect(new Set(played.map((s) => s.frame)).size, 'distinct frames sampled at full weight').toBeGreaterThanOrEqual(8);
+  let nodded = 0;
+  for (const s of played) {
+    CHECKED.forEach((n, k) => expect(s.influences[k], `${n} at frame ${s.frame}`).toBeCloseTo(take.arkit[s.frame * 52 + ARKIT_NAMES.indexOf(n)], 6));
+    const [rx, ry, rz] = take.pose.slice(s.frame * 6, s.frame * 6 + 3);
+    const angle = Math.hypot(rx, ry, rz), sin = Math.sin(angle / 2) / (angle || 1);
+    const want = [rx * sin, ry * sin, rz * sin, Math.cos(angle / 2)];
+    const dot = Math.abs(want.reduce((a, w, i) => a + w * s.turn[i], 0));
+    expect(2 * Math.acos(Math.min(1, dot)), `the head's turn at frame ${s.frame}`).toBeLessThan(1e-4);
+    nodded = Math.max(nodded, angle);
+  }
+  expect(nodded, 'the head turns').toBeGreaterThan(0.01);
+  const jaw = played.map((s) => s.influences[0]);
+  expect(Math.max(...jaw) - Math.min(...jaw), 'jawOpen moves').toBeGreaterThan(0.15);
+  // After the take the face goes back to its rest (blended out over 0.4 s), the head to neutral.
+  await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
+
+  // 2. Live: the fake microphone plays speech; the jaw moves, and Stop releases the microphone.
+  await sample(page, CHECKED);
+  await page.locator('#listen').click();
+  await expect(page.locator('#log')).toHaveText('listening');
+  await page.waitForTimeout(4000);
+  const live = await collect(page);
+  const liveJaw = live.map((s) => s.influences[0]);
+  expect(Math.max(...liveJaw) - Math.min(...liveJaw), 'jawOpen moves live').toBeGreaterThan(0.1);
+  expect(Math.max(...live.map((s) => s.speech)), 'blended in').toBe(1);
+  await page.locator('#stop').click();
+  await expect(page.locator('#log')).toHaveText('stopped listening');
+  await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
+});
