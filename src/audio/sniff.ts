@@ -41,7 +41,8 @@ export function undecodableReason(bytes: ArrayBuffer): string | null {
   if (ascii(b, 0, 4) === 'FORM' && /^AIF[FC]$/.test(ascii(b, 8, 4))) return `it is an AIFF file, which this browser cannot decode: ${CONVERT}`;
   if (looksLikeText(b)) {
     // A URL that is not there often brings the site's index page (a host's fallback), not an error.
-    return /^\s*<(!doctype html|html|head|body)/i.test(ascii(b, 0, Math.min(b.length, 200)))
+    // (decoded: a UTF-8 byte-order mark before the page, as some editors and hosts write, is dropped)
+    return /^\s*<(!doctype html|html|head|body)/i.test(new TextDecoder().decode(b.subarray(0, 200)))
       ? 'it is an HTML page, not audio (a wrong URL, which the site answered with a page?)'
       : 'it is a text file, not audio';
   }

@@ -58,10 +58,11 @@ export class GltfAvatar {
     const bytes = bufferOf(data, source);
     const start = new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength));
     const magic = String.fromCharCode(...start.subarray(0, 4));
-    const firstChar = String.fromCharCode(...start).trimStart()[0];
+    const firstChar = new TextDecoder().decode(start).trimStart()[0]; // (a UTF-8 byte-order mark is dropped)
     if (magic !== 'glTF' && firstChar !== '{') {
-      const what = firstChar === '<' ? 'it is an HTML page: is the URL right?' : `a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}`;
-      throw new AvatarLoadError(`${source} is not a glTF file (${what}): export the avatar as .glb`);
+      throw new AvatarLoadError(firstChar === '<'
+        ? `${source} is not a glTF file but an HTML page, as hosts send for a missing file: is the URL right?`
+        : `${source} is not a glTF file (a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}): export the avatar as .glb`);
     }
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
     let gltf: GLTF;
@@ -75,6 +76,7 @@ export class GltfAvatar {
 
   /** Bind a loaded glTF: find its targets and head bone. */
   static bind(gltf: GLTF, source: string, headBone?: string | null): GltfAvatar {
+    if (!gltf?.scene) throw new AvatarLoadError(`${source} has no scene: export the avatar with its scene`);
     const arkit: Target[] = [];
     const visemes: Target[] = [];
     const names = new Set<string>();

@@ -54,7 +54,7 @@ export async function fetchManifest(url: string | URL | undefined, fetchFn: type
   if (!body.ok) throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: HTTP ${body.status}`);
   const text = new TextDecoder().decode(body.bytes);
   if (/^\s*</.test(text)) {
-    throw new ModelLoadError(`the model manifest ${manifestUrl} is an HTML page, not the manifest: no manifest.json there (hosts send their index page for a missing file); serve the build's models/ folder there, or give the model's URL (the element's model attribute)`);
+    throw new ModelLoadError(`the model manifest ${manifestUrl} is an HTML page, not the manifest: no manifest.json there (hosts send their index page for a missing file); serve the build's models/ folder there, or give the manifest's URL (TalkingFaceEngine.load({ manifestUrl }), or the element's model attribute)`);
   }
   try {
     return { manifest: checkManifest(JSON.parse(text)), manifestUrl };

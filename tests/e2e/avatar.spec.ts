@@ -200,7 +200,7 @@ test('an avatar file that is not glTF, or has neither naming scheme, gives a cle
   // A missing file: this project's server answers 404; many static hosts answer with their index page instead.
   expect(await errorOf('/examples/avatars/missing.glb')).toMatch(/^avatar: .*could not fetch the avatar .*missing\.glb: HTTP 404/);
   await page.route('**/examples/avatars/spa-fallback.glb', (route) => route.fulfill({ status: 200, contentType: 'text/html', body: '<!doctype html><html><body>app</body></html>' }));
-  expect(await errorOf('/examples/avatars/spa-fallback.glb')).toMatch(/^avatar: .*spa-fallback\.glb is not a glTF file \(it is an HTML page: is the URL right\?\)/);
+  expect(await errorOf('/examples/avatars/spa-fallback.glb')).toMatch(/^avatar: .*spa-fallback\.glb is not a glTF file but an HTML page, as hosts send for a missing file: is the URL right\?$/);
   const unnamed = await errorOf(await blobUrl(renamedAvatar((n) => n.replace('viseme_', 'mouth_shape_'))));
   expect(unnamed).toMatch(/no morph targets named after ARKit's 52 blend shapes .* or the 15 Oculus visemes/);
   expect(unnamed).toContain('its morph targets are: mouth_shape_sil, mouth_shape_PP, mouth_shape_FF');

@@ -55,6 +55,8 @@ describe('undecodableReason', () => {
     expect(undecodableReason(bytes(0x25, 0x50, 0x44, 0x46))).toBe('it is a PDF document, not audio');
     expect(undecodableReason(new TextEncoder().encode('Lines of notes,\nnot a recording. Ünïcödé\t😀'.repeat(200)).buffer)).toBe('it is a text file, not audio');
     expect(undecodableReason(new TextEncoder().encode('<!DOCTYPE html>\n<html><body>app</body></html>').buffer)).toBe('it is an HTML page, not audio (a wrong URL, which the site answered with a page?)');
+    // With a UTF-8 byte-order mark before it, as some editors and hosts write.
+    expect(undecodableReason(new TextEncoder().encode('\ufeff<!doctype html><html></html>').buffer)).toBe('it is an HTML page, not audio (a wrong URL, which the site answered with a page?)');
   });
 
   it('says nothing where the first bytes do not tell (the browser\'s reason is then given)', () => {

@@ -108,6 +108,13 @@ describe('GltfAvatar', () => {
     expect(() => GltfAvatar.bind(fake(['smile', 'blink', 'A']), 'face.glb')).toThrow(/face\.glb has no morph targets named after ARKit's 52 .* its morph targets are: smile, blink, A\./);
     expect(() => GltfAvatar.bind(fake([]), 'bare.glb')).toThrow(/it has no morph targets at all/);
     await expect(GltfAvatar.parse(new TextEncoder().encode('ID3\u0004 an mp3').buffer as ArrayBuffer, 'song.mp3')).rejects.toThrow(/song\.mp3 is not a glTF file .*starts with "ID3/);
+    for (const page of ['<!doctype html><html></html>', '\ufeff\n<html>']) { // a host's page for a missing file, a byte-order mark or not
+      await expect(GltfAvatar.parse(new TextEncoder().encode(page).buffer as ArrayBuffer, 'me.glb')).rejects.toThrow(/^me\.glb is not a glTF file but an HTML page, as hosts send for a missing file: is the URL right\?$/);
+    }
+    // A .gltf (JSON) with a byte-order mark is read as JSON, not refused at its first byte.
+    const json = (text: string) => new TextEncoder().encode(text).buffer as ArrayBuffer;
+    await expect(GltfAvatar.parse(json('\ufeff{"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0}'), 'me.gltf')).rejects.toThrow(/it has no morph targets at all/);
+    await expect(GltfAvatar.parse(json('{"asset":{"version":"2.0"}}'), 'empty.gltf')).rejects.toThrow(/^empty\.gltf has no scene: export the avatar with its scene$/);
     const broken = new Uint8Array(file('arkit-face.glb').slice(0, 200)); // a .glb cut short
     await expect(GltfAvatar.parse(broken.buffer, 'cut.glb')).rejects.toThrow(/cut\.glb could not be read as glTF/);
   });
