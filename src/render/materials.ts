@@ -125,7 +125,7 @@ export function headColors(t: FaceTemplate, shell: Float32Array | null, egg: { c
       const line = z > 0 ? egg.up * (0.1 + 0.4 * Math.min(1, z / (0.4 * egg.back))) : egg.up * (0.1 - 1.0 * back * back);
       // A transition two or three of the shell's rings wide, eased: a sharper one shows their triangles as a sawtooth.
       const f = Math.min(1, Math.max(0, (y - line) / (0.3 * egg.up) + 0.25));
-      // Skin round each ear (a margin of about half its size), as hair grows above and behind it, not up to it.
+      // Skin round each ear (a margin of about a third of its size), as hair grows above and behind it, not up to it.
       const e = ear && Math.abs(shell[3 * i] - egg.center[0]) > 0.5 * egg.ax
         ? Math.hypot((shell[3 * i + 1] - ear.y) / ear.height, (shell[3 * i + 2] - ear.z) / ear.width) : Infinity;
       const bare = Math.min(1, Math.max(0, (0.85 - e) / 0.3));

@@ -1,8 +1,8 @@
 /**
  * A look into an open eye meets something (src/render/eyes.ts, head.ts): parallel rays on a grid over each eye
- * opening, from the front, from aside, from above and from steeply below, hit the head's surfaces as three.js
- * draws them (each material's side) or the ball; none goes through to the page. Before the skirts behind the
- * openings, rays past the ball at the inner corners went into the head, whose inside is not drawn.
+ * opening, from the front, 55 degrees aside, 35 above, 50 below and 35 below-and-aside (`views`), hit the head's
+ * surfaces as three.js draws them (each material's side) or the ball; none goes through to the page. Before the
+ * skirts behind the openings, rays past the ball at the inner corners went into the head, whose inside is not drawn.
  */
 import { beforeAll, describe, expect, it } from 'vitest';
 import * as THREE from 'three';
