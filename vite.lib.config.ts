@@ -16,6 +16,7 @@ import { captureWorkletFile } from './scripts/worklet-file.ts';
  * `--mode npm` builds the same entry for bundlers into dist/lib/npm/ (the package's import): three.js is left to the
  * project that installs it (a peer dependency), so a page with its own three.js scene has one copy of it, not two.
  * dist/lib/talking-face.js keeps its own, for a page that loads it with one script tag and no bundler.
+ * dist/lib/npm/engine.js (`talking-face/engine`) is the library without the element, for a page that draws its own.
  */
 export default defineConfig(({ mode }) => mode === 'npm' ? forBundlers : standalone);
 
@@ -60,7 +61,13 @@ const forBundlers = defineConfig({
     target: 'es2022',
     sourcemap: true,
     chunkSizeWarningLimit: 1024,
-    lib: { entry: resolve(import.meta.dirname, 'src/component/index.ts'), formats: ['es'], fileName: () => 'talking-face.js' },
+    // Two entries: the element and the library (talking-face.js), and the library alone (engine.js: `talking-face/engine`,
+    // which defines no element and does not bring the face's renderer); what they share goes in a chunk of its own.
+    lib: {
+      entry: { 'talking-face': resolve(import.meta.dirname, 'src/component/index.ts'), engine: resolve(import.meta.dirname, 'src/index.ts') },
+      formats: ['es'],
+      fileName: (_format, name) => `${name}.js`,
+    },
     rollupOptions: { external: [/^three($|\/)/] },
   },
   plugins: [captureWorkletFile()],

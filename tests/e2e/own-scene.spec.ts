@@ -5,11 +5,12 @@ import { ARKIT_NAMES } from '../../src/avatar/names';
 
 /**
  * examples/own-scene.html: a page with its own three.js scene (the project's three.js through its import map) loads
- * the test avatar with its own GLTFLoader, places it turned, and has the package's build for bundlers
- * (dist/lib/npm/, three.js external) drive it: GltfAvatar.bind + AvatarDriver, frame by frame on the audio clock, and
- * live from a (fake) microphone. Read from the avatar itself at many instants: its morph targets are the take's
- * weights for the frame shown and its head bone, relative to the avatar's root, is the predicted rotation on top of
- * its rest, although the page turned the avatar. One three.js, from the page's origin; no console error (fixtures.ts).
+ * the test avatar with its own GLTFLoader, places it turned, and has the package's build for bundlers without the
+ * element (dist/lib/npm/engine.js, three.js external) drive it: GltfAvatar.bind + AvatarDriver, frame by frame on
+ * the audio clock, and live from a (fake) microphone. Read from the avatar itself at many instants: its morph
+ * targets are the take's weights for the frame shown and its head bone, relative to the avatar's root, is the
+ * predicted rotation on top of its rest, although the page turned the avatar. One three.js, from the page's origin,
+ * and no element defined; no console error (fixtures.ts).
  */
 test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
@@ -64,8 +65,9 @@ test('an avatar in the page\'s own three.js scene speaks a take frame by frame, 
   // The page's three.js is the project's, from its origin, and the only one: the library did not bring its own.
   const paths = guard.requests.map((u) => new URL(u).pathname);
   expect(paths).toContain('/examples/vendor/three-project/build/three.module.js');
-  expect(paths).toContain('/lib/npm/talking-face.js');
-  expect(paths).not.toContain('/lib/talking-face.js');
+  expect(paths).toContain('/lib/npm/engine.js');
+  expect(paths.filter((p) => p.endsWith('/talking-face.js')), 'the element\'s entries').toEqual([]);
+  expect(await page.evaluate(() => customElements.get('talking-face')), 'no element defined').toBeUndefined();
   expect(warnings.filter((w) => /Multiple instances of Three/.test(w))).toEqual([]);
   expect(await page.evaluate(() => (globalThis as any).ownSceneExample.scene.getObjectByName('Head') !== undefined)).toBe(true);
 

@@ -33,6 +33,29 @@ test('imports where there is no DOM, with three.js its importer\'s', () => {
   expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
 });
 
+test('talking-face/engine is the library without the element and without the face\'s renderer', () => {
+  const out = run('node', ['--input-type=module', '-e', [
+    "const m = await import('talking-face/engine');",
+    "console.log([typeof m.TalkingFaceEngine.load, typeof m.AvatarDriver, typeof m.GltfAvatar.bind, String('TalkingFaceElement' in m), String('defineTalkingFace' in m)].join(' '))",
+  ].join(' ')]);
+  expect(out.trim()).toBe('function function function false false');
+  // What importing it loads: engine.js and the chunks it imports, none of them holding the element (its definition,
+  // its attributes) or the views that draw (their camera controls, the head's teeth): names a minifier keeps.
+  const dir = join(ROOT, 'dist/lib/npm');
+  const loaded = new Set<string>(), pending = ['engine.js'];
+  while (pending.length) {
+    const file = pending.pop()!;
+    if (loaded.has(file)) continue;
+    loaded.add(file);
+    for (const m of readFileSync(join(dir, file), 'utf8').matchAll(/(?:from|import)\s*"\.\/([^"]+\.js)"/g)) pending.push(m[1]);
+  }
+  expect(loaded.has('talking-face.js'), [...loaded].join(', ')).toBe(false);
+  for (const file of loaded) {
+    const code = readFileSync(join(dir, file), 'utf8');
+    expect(code, file).not.toMatch(/customElements\.define|observedAttributes|OrbitControls|RoundedBoxGeometry/);
+  }
+});
+
 test('its declarations type a project that resolves modules as Node does (node16)', () => {
   test.setTimeout(120_000);
   const dir = mkdtempSync(join(ROOT, 'dist/consumer-'));
@@ -40,6 +63,8 @@ test('its declarations type a project that resolves modules as Node does (node16
     writeFileSync(join(dir, 'use.ts'), [
       "import 'talking-face';",
       "import { TalkingFaceEngine, setRuntimeBase, type TalkingFaceElement } from 'talking-face';",
+      "import { AvatarDriver, type DrivenFrames } from 'talking-face/engine';",
+      "export const show = (d: AvatarDriver, f: DrivenFrames): void => d.show(f, 0);",
       "setRuntimeBase('/ort/');",
       "const face = document.createElement('talking-face') as TalkingFaceElement;",
       "face.addEventListener('frame', (e) => { const n: number = e.detail.frame; console.log(n); });",
