@@ -41,7 +41,7 @@ const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
  * Either build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker
  * (ort-runtime.ts). A failed load is forgotten, so the next one tries again.
  */
-export function loadOrt(build: OrtBuild): Promise<typeof Ort> {
+function loadOrt(build: OrtBuild): Promise<typeof Ort> {
   ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then(async (ort) => {
     ort.env.wasm.numThreads = ortThreads();
     // onnxruntime reports node placement notes as warnings through console.error; keep real errors only.

@@ -3,7 +3,6 @@
  * created in it; and what the page's own sessions (onnx-model.ts) share with it: where onnxruntime's files are, its
  * threads, its session options, the count of sessions asked for.
  */
-import type * as Ort from 'onnxruntime-web';
 import { STALL_SECONDS } from '../model/fetch-body';
 import type { ExecutionProvider, Feeds, SessionSpec } from './onnx-spec';
 
@@ -232,6 +231,10 @@ export function getRuntimeStallSeconds(): number {
   return runtimeStallSeconds;
 }
 
-export function sessionOptions(provider: ExecutionProvider): Ort.InferenceSession.SessionOptions {
-  return { executionProviders: [provider], graphOptimizationLevel: 'all', logSeverityLevel: 3 };
+/**
+ * The options every session is created with (onnxruntime's InferenceSession.SessionOptions; typed by what it holds,
+ * so that the package's declarations do not name onnxruntime-web, which the package bundles and does not depend on).
+ */
+export function sessionOptions(provider: ExecutionProvider) {
+  return { executionProviders: [provider], graphOptimizationLevel: 'all' as const, logSeverityLevel: 3 as const };
 }

@@ -1,6 +1,6 @@
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
-import { join, resolve } from 'node:path';
+import { dirname, join, resolve } from 'node:path';
 import { test, expect } from '@playwright/test';
 
 /**
@@ -31,6 +31,36 @@ test('imports where there is no DOM, with three.js its importer\'s', () => {
   const code = readFileSync(join(ROOT, 'dist/lib/npm/talking-face.js'), 'utf8');
   expect(code).toMatch(/from\s*"three"/);
   expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
+});
+
+test('needs nothing installed beside it but its peers: its code and its declarations import only three.js', () => {
+  const pkg = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')) as { dependencies?: object; peerDependencies: object; exports: Record<string, Record<string, string>> };
+  expect(pkg.dependencies ?? {}, 'dependencies (onnxruntime-web is bundled into the code, its runtime into dist/ort)').toEqual({});
+  const peer = (specifier: string) => Object.keys(pkg.peerDependencies).some((p) => specifier === p || specifier.startsWith(`${p}/`));
+  // Every file reachable from an export, through relative imports; the bare ones it names.
+  const bare = new Map<string, string>(), visited = new Set<string>();
+  for (const entry of Object.values(pkg.exports)) {
+    for (const start of Object.values(entry)) {
+      const pending = [resolve(ROOT, start)], seen = new Set<string>();
+      while (pending.length) {
+        const file = pending.pop()!;
+        if (seen.has(file)) continue;
+        seen.add(file);
+        visited.add(file.slice(ROOT.length + 1));
+        // A statement's `import ... from "x"` / `export ... from "x"` / `import "x"`, and `import("x")`: what a module imports.
+        const imports = /^\s*(?:import|export)\b[^;"']*?\bfrom\s*["']([^"'\s]+)["']|^\s*import\s*["']([^"'\s]+)["']|\bimport\s*\(\s*["']([^"'\s]+)["']/gm;
+        for (const m of readFileSync(file, 'utf8').matchAll(imports)) {
+          const s = m[1] ?? m[2] ?? m[3];
+          if (!s.startsWith('.')) bare.set(s, file.slice(ROOT.length + 1));
+          else if (s.endsWith('.js') || s.endsWith('.d.ts')) pending.push(s.endsWith('.js') && file.endsWith('.d.ts') ? resolve(dirname(file), s.replace(/\.js$/, '.d.ts')) : resolve(dirname(file), s));
+        }
+      }
+    }
+  }
+  expect([...bare].filter(([s]) => !peer(s)).map(([s, f]) => `${s} (${f})`)).toEqual([]);
+  expect([...bare.keys()]).toContain('three');
+  // The walk went deep: the encoders' declarations, which named onnxruntime-web's types before.
+  expect([...visited]).toContain('dist/lib/types/encoders/onnx-model.d.ts');
 });
 
 test('talking-face/engine is the library without the element and without the face\'s renderer', () => {
