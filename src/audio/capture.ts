@@ -276,7 +276,7 @@ async function addCaptureModule(context: AudioContext): Promise<void> {
     await context.audioWorklet.addModule(file).catch((e: Error) => {
       throw new Error(`the audio capture could not be loaded (${(fromBlob as Error).message}; from the library's files: ${e.message}): ` +
         `a Content-Security-Policy must allow blob: or the page's own scripts (script-src 'self'), and ${file} must be served ` +
-        '(a bundler does not copy it: copy the package\'s dist/lib/npm/capture-worklet.js there)');
+        '(a bundler does not copy it: copy capture-worklet.js there, from the package\'s dist/lib/npm/ or the build\'s lib/)');
     });
   } finally {
     URL.revokeObjectURL(url);

@@ -33,10 +33,12 @@ test('imports where there is no DOM, with three.js its importer\'s', () => {
   expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
 });
 
-test('needs nothing installed beside it but its peers: its code and its declarations import only three.js', () => {
+test('needs nothing installed beside it but its peers: its code and its declarations import only three.js (and React\'s types, for JSX)', () => {
   const pkg = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')) as { dependencies?: object; peerDependencies: object; exports: Record<string, Record<string, string>> };
   expect(pkg.dependencies ?? {}, 'dependencies (onnxruntime-web is bundled into the code, its runtime into dist/ort)').toEqual({});
-  const peer = (specifier: string) => Object.keys(pkg.peerDependencies).some((p) => specifier === p || specifier.startsWith(`${p}/`));
+  // A peer's specifier, or its types' (@types/react is what 'react' names in the declarations of talking-face/jsx).
+  const peers = Object.keys(pkg.peerDependencies).map((p) => p.replace(/^@types\//, ''));
+  const peer = (specifier: string) => peers.some((p) => specifier === p || specifier.startsWith(`${p}/`));
   // Every file reachable from an export, through relative imports; the bare ones it names.
   const bare = new Map<string, string>(), visited = new Set<string>();
   for (const entry of Object.values(pkg.exports)) {
@@ -86,28 +88,58 @@ test('talking-face/engine is the library without the element and without the fac
   }
 });
 
-test('its declarations type a project that resolves modules as Node does (node16)', () => {
-  test.setTimeout(120_000);
+/** Type-check `files` (name -> source) as a project with these compiler options; tsc's output ('' when none). */
+function typecheck(files: Record<string, string>, options: object): string {
   const dir = mkdtempSync(join(ROOT, 'dist/consumer-'));
   try {
-    writeFileSync(join(dir, 'use.ts'), [
-      "import 'talking-face';",
-      "import { TalkingFaceEngine, setRuntimeBase, type TalkingFaceElement } from 'talking-face';",
-      "import { AvatarDriver, type DrivenFrames } from 'talking-face/engine';",
-      "export const show = (d: AvatarDriver, f: DrivenFrames): void => d.show(f, 0);",
-      "setRuntimeBase('/ort/');",
-      "const face = document.createElement('talking-face') as TalkingFaceElement;",
-      "face.addEventListener('frame', (e) => { const n: number = e.detail.frame; console.log(n); });",
-      "export const load: typeof TalkingFaceEngine.load = TalkingFaceEngine.load;",
-    ].join('\n'));
-    writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
-      target: 'es2022', module: 'node16', moduleResolution: 'node16', strict: true, noEmit: true, lib: ['es2022', 'dom', 'dom.iterable'], types: [],
-    }, files: ['use.ts'] }));
-    const tsc = join(ROOT, 'node_modules/.bin/tsc');
-    let errors = '';
-    try { run(tsc, ['-p', dir]); } catch (e) { errors = String((e as { stdout?: string }).stdout ?? e); }
-    expect(errors).toBe('');
+    for (const [name, source] of Object.entries(files)) writeFileSync(join(dir, name), source);
+    writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: { strict: true, noEmit: true, ...options }, files: Object.keys(files) }));
+    try {
+      run(join(ROOT, 'node_modules/.bin/tsc'), ['-p', dir]);
+      return '';
+    } catch (e) {
+      return String((e as { stdout?: string }).stdout ?? e);
+    }
   } finally {
     rmSync(dir, { recursive: true, force: true });
   }
+}
+
+test('talking-face/jsx types the element in React\'s JSX: its attributes, and a ref as TalkingFaceElement', () => {
+  test.setTimeout(120_000);
+  const use = [
+    "import type {} from 'talking-face/jsx';",
+    "import type { TalkingFaceElement } from 'talking-face';",
+    "import { useRef } from 'react';",
+    'export function Face() {',
+    '  const ref = useRef<TalkingFaceElement>(null);',
+    '  return (<>',
+    '    <talking-face ref={ref} src="/hello.wav" autoplay backend="cpu" head-motion={1.5} avatar="/me.glb" avatar-head-bone="Head" hide-status className="face" />',
+    '    {/* @ts-expect-error: not one of its backends */}',
+    '    <talking-face backend="gpu" />',
+    '    {/* @ts-expect-error: no such attribute */}',
+    '    <talking-face srcc="/hello.wav" />',
+    '  </>);',
+    '}',
+    'export const stop = (face: TalkingFaceElement | null) => face?.stop();',
+  ].join('\n');
+  const options = { target: 'es2022', module: 'esnext', moduleResolution: 'bundler', jsx: 'react-jsx', lib: ['es2022', 'dom'], types: [] };
+  expect(typecheck({ 'use.tsx': use }, options)).toBe('');
+  // Without the opt-in, React's JSX does not know the element.
+  expect(typecheck({ 'use.tsx': use.replace("import type {} from 'talking-face/jsx';", '') }, options)).toMatch(/talking-face/);
+});
+
+test('its declarations type a project that resolves modules as Node does (node16)', () => {
+  test.setTimeout(120_000);
+  const use = [
+    "import 'talking-face';",
+    "import { TalkingFaceEngine, setRuntimeBase, type TalkingFaceElement } from 'talking-face';",
+    "import { AvatarDriver, type DrivenFrames } from 'talking-face/engine';",
+    "export const show = (d: AvatarDriver, f: DrivenFrames): void => d.show(f, 0);",
+    "setRuntimeBase('/ort/');",
+    "const face = document.createElement('talking-face') as TalkingFaceElement;",
+    "face.addEventListener('frame', (e) => { const n: number = e.detail.frame; console.log(n); });",
+    "export const load: typeof TalkingFaceEngine.load = TalkingFaceEngine.load;",
+  ].join('\n');
+  expect(typecheck({ 'use.ts': use }, { target: 'es2022', module: 'node16', moduleResolution: 'node16', lib: ['es2022', 'dom', 'dom.iterable'], types: [] })).toBe('');
 });
