@@ -16,6 +16,7 @@ import type { BlendshapeFrames } from './weights';
 import { ARKIT_NAMES, VISEME_NAMES } from './names';
 import type { GltfAvatar } from './gltf-avatar';
 import { Blinks } from './blinks';
+import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
 
 /** Seconds speech takes to blend in from the rest, and back out to it (setSpeaking), as the template face's (face-view.ts). */
 export const BLEND_IN_SECONDS = 0.12, BLEND_OUT_SECONDS = 0.4;
@@ -27,14 +28,24 @@ export interface DrivenFrames {
   blendshapes?: BlendshapeFrames;
 }
 
+/** Live frames: streamed Frames (engine.listen, createStream), with each frame's speech probability. */
+export interface DrivenLiveFrames extends DrivenFrames {
+  speech: Float32Array;
+}
+
 export class AvatarDriver {
   /** Idle blinks on top of the model's eyeBlink weights (an avatar without eyeBlink targets has none). Off for reduced motion. */
   blinking = true;
   /**
    * The head's turn goes on top of the head bone's rotation as the page's own animation (an AnimationMixer) set it
    * this frame, instead of on top of its rest: update() applies it, so call update() after the mixer's update.
+   * (Without it, the page's animation and the driver each set the bone: whichever sets it last in a frame is seen.)
    */
   headOnTop = false;
+  /** Whether update() turned the head last time (with headOnTop): one more update() then turns it back. */
+  private headTurned = false;
+  /** Live frames since speech was last heard (showLive). */
+  private quiet = LIVE_REST_FRAMES;
   private readonly blinks: Blinks;
   private blink = 0;
   /** The frame last given (weights, visemes, head rotation); how much of it is shown against the rest is `speech`. */
@@ -49,6 +60,9 @@ export class AvatarDriver {
 
   /** `now`: the clock update() will be given (ms; performance.now() by default); `random`: for the blinks (tests seed it). */
   constructor(readonly avatar: GltfAvatar, now = globalThis.performance?.now() ?? 0, random: () => number = Math.random) {
+    if (typeof (avatar as Partial<GltfAvatar> | null)?.setWeights !== 'function') {
+      throw new TypeError('AvatarDriver takes a GltfAvatar: new AvatarDriver(GltfAvatar.bind(gltf, name))');
+    }
     this.blinks = new Blinks(now, random);
   }
 
@@ -62,13 +76,28 @@ export class AvatarDriver {
    * BLEND_IN_SECONDS by update()). A take made without `blendshapes: true` is refused, saying so.
    */
   show(frames: DrivenFrames, frame: number): void {
-    if (!frames.blendshapes) throw new Error('AvatarDriver.show: these frames have no blend-shape output: animate (or createStream, listen) with { blendshapes: true }');
+    this.apply(frames, frame, 'show');
+    this.setSpeaking(true);
+  }
+
+  /**
+   * Show frame `frame` of live frames, in order as they come: as show(), but the face goes back to rest after
+   * LIVE_REST_FRAMES frames without speech (a pause between phrases; a breath between words does not) and speaks
+   * again when speech comes, as <talking-face live> does.
+   */
+  showLive(frames: DrivenLiveFrames, frame: number): void {
+    this.apply(frames, frame, 'showLive');
+    this.quiet = frames.speech[Math.floor(frame)] > SPEECH_PROBABILITY ? 0 : this.quiet + 1;
+    this.setSpeaking(this.quiet < LIVE_REST_FRAMES);
+  }
+
+  private apply(frames: DrivenFrames, frame: number, name: string): void {
+    if (!frames.blendshapes) throw new Error(`AvatarDriver.${name}: these frames have no blend-shape output: animate (or createStream, listen) with { blendshapes: true }`);
     const count = frames.pose.length / 6;
-    if (!(frame >= 0 && frame < count)) throw new RangeError(`AvatarDriver.show: frame ${frame} is outside 0..${count - 1}`);
+    if (!(frame >= 0 && frame < count)) throw new RangeError(`AvatarDriver.${name}: frame ${frame} is outside 0..${count - 1}`);
     const f = Math.floor(frame);
     this.setBlendshapes(frames.blendshapes, f);
     this.setPose(frames.pose[f * 6], frames.pose[f * 6 + 1], frames.pose[f * 6 + 2]);
-    this.setSpeaking(true);
   }
 
   /** Frame `frame` of the blend-shape output onto the avatar's morph targets. */
@@ -103,7 +132,8 @@ export class AvatarDriver {
   /**
    * Speech starts (true: blended in from the rest over BLEND_IN_SECONDS) or stops (false: playback stopped or ended,
    * a pause live): the face goes back to rest and the head to neutral over BLEND_OUT_SECONDS, instead of holding the
-   * frame last shown (mid-word, when stopped). update() moves the blend.
+   * frame last shown (mid-word, when stopped). update() moves the blend. A show() after it speaks again: a live
+   * session's stop() hands over its last frames before it resolves, so show nothing more once stopping, then call this.
    */
   setSpeaking(on: boolean): void {
     if (this.target === (on ? 1 : 0)) return;
@@ -127,9 +157,10 @@ export class AvatarDriver {
       this.avatar.setIdleBlink(blink);
       changed = true;
     }
-    if (this.headOnTop && this.speech > 0) {
+    if (this.headOnTop && (this.speech > 0 || this.headTurned)) {
       const s = this.speech, h = this.shown.head;
-      this.avatar.setHeadRotation(s * h[0], s * h[1], s * h[2], true);
+      this.avatar.setHeadRotation(s * h[0], s * h[1], s * h[2], true); // at speech 0, the animation's rotation alone
+      this.headTurned = s > 0;
       changed = true;
     }
     return changed;
@@ -137,7 +168,7 @@ export class AvatarDriver {
 
   /** Back to the avatar's own neutral face, at once. */
   reset(): void {
-    [this.speech, this.target] = [0, 0];
+    [this.speech, this.target, this.quiet, this.headTurned] = [0, 0, LIVE_REST_FRAMES, false];
     this.avatar.reset();
   }
 

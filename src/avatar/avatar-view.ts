@@ -10,7 +10,7 @@ import * as THREE from 'three';
 import { fitToCanvas, OnScreen } from '../render/canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
-import { GltfAvatar } from './gltf-avatar';
+import { GltfAvatar, type AvatarBindOptions } from './gltf-avatar';
 import { AvatarDriver } from './avatar-driver';
 import { pixelRatio, softwareWebGL } from '../render/software-gl';
 import { fetchBody, StalledError } from '../model/fetch-body';
@@ -39,6 +39,7 @@ export class AvatarView {
     this.renderer.setPixelRatio(pixelRatio());
     this.scene.background = new THREE.Color(0x1d2230);
     this.scene.add(avatar.gltf.scene);
+    if (avatar.facing === '-z') avatar.gltf.scene.rotation.y += Math.PI; // its face towards the camera (it turns in its own axes)
     this.scene.add(new THREE.HemisphereLight(0xfff4ea, 0x39303a, 1.1));
     const key = new THREE.DirectionalLight(0xffffff, 2.0);
     key.position.set(0.6, 0.8, 1.5);
@@ -75,14 +76,14 @@ export class AvatarView {
   }
 
   /** Fetch, parse and show the avatar at `url` (AvatarLoadError says what is wrong with it). */
-  static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null): Promise<AvatarView> {
+  static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null, options: AvatarBindOptions = {}): Promise<AvatarView> {
     const res = await fetchBody(url).catch((e: Error) => {
       const other = new URL(url, location.href).origin !== location.origin;
       const hint = other && !(e instanceof StalledError) ? ' (another origin: does it send CORS headers?)' : '';
       throw new Error(`could not fetch the avatar ${url}: ${e.message}${hint}`);
     });
     if (!res.ok) throw new Error(`could not fetch the avatar ${url}: HTTP ${res.status}`);
-    return new AvatarView(canvas, await GltfAvatar.parse(res.bytes, url, headBone));
+    return new AvatarView(canvas, await GltfAvatar.parse(res.bytes, url, headBone, options));
   }
 
   /** The speech weight now (0: the rest, 1: the frame given), as FaceView's. */

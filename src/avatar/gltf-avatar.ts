@@ -30,8 +30,18 @@ export interface AvatarSummary {
   headBone: string | null;
 }
 
+/** How a glTF avatar is bound: which way its face looks (glTF's convention, +z, unless said otherwise). */
+export interface AvatarBindOptions {
+  /** '+z' (glTF's convention, default) or '-z' (VRM 0.x models, and others made facing away from a glTF camera). */
+  facing?: '+z' | '-z';
+}
+
 export class GltfAvatar {
   private readonly rest = new THREE.Quaternion();
+  /** setHeadRotation's `onTop`: the rotation it turned (the page's animation of the bone) and the one it wrote. */
+  private readonly onTopBase = new THREE.Quaternion();
+  private readonly onTopWritten = new THREE.Quaternion();
+  private onTopActive = false;
 
   /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
   private readonly modelBlink = [0, 0];
@@ -45,6 +55,7 @@ export class GltfAvatar {
     readonly head: THREE.Object3D | null,
     /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
     private readonly blinkTargets: Target[],
+    readonly facing: '+z' | '-z',
   ) {
     if (head) this.rest.copy(head.quaternion);
   }
@@ -52,9 +63,10 @@ export class GltfAvatar {
   /**
    * Parse a .glb (or .gltf JSON) and bind it: `data` is the file's bytes (an ArrayBuffer, or a view of them such as
    * a Uint8Array or Node's Buffer). `source` names the file in messages; `headBone` is the `avatar-head-bone`
-   * attribute (default: a bone named Head or head). Throws AvatarLoadError with what is wrong.
+   * attribute (default: a bone named Head or head); `options.facing` which way the face looks. Throws AvatarLoadError
+   * with what is wrong.
    */
-  static async parse(data: ArrayBuffer | ArrayBufferView, source: string, headBone?: string | null): Promise<GltfAvatar> {
+  static async parse(data: ArrayBuffer | ArrayBufferView, source: string, headBone?: string | null, options: AvatarBindOptions = {}): Promise<GltfAvatar> {
     const bytes = bufferOf(data, source);
     const start = new Uint8Array(bytes, 0, Math.min(64, bytes.byteLength));
     const magic = String.fromCharCode(...start.subarray(0, 4));
@@ -71,12 +83,20 @@ export class GltfAvatar {
     } catch (e) {
       throw new AvatarLoadError(`${source} could not be read as glTF: ${(e as Error).message}`);
     }
-    return GltfAvatar.bind(gltf, source, headBone);
+    return GltfAvatar.bind(gltf, source, headBone, options);
   }
 
-  /** Bind a loaded glTF: find its targets and head bone. */
-  static bind(gltf: GLTF, source: string, headBone?: string | null): GltfAvatar {
+  /**
+   * Bind a loaded glTF (what GLTFLoader gives: `gltf`, not `gltf.scene`): find its targets and its head bone (the
+   * one named `headBone`, else Head or head, else a bone whose name ends in head). `source` names it in messages.
+   */
+  static bind(gltf: GLTF, source: string, headBone?: string | null, options: AvatarBindOptions = {}): GltfAvatar {
+    if ((gltf as unknown as THREE.Object3D)?.isObject3D) {
+      throw new TypeError(`GltfAvatar.bind(${source}): give what GLTFLoader gave (gltf), not its scene: GltfAvatar.bind(gltf, ...)`);
+    }
     if (!gltf?.scene) throw new AvatarLoadError(`${source} has no scene: export the avatar with its scene`);
+    const facing = options.facing ?? '+z';
+    if (facing !== '+z' && facing !== '-z') throw new TypeError(`GltfAvatar.bind(${source}): facing is '+z' or '-z', not ${JSON.stringify(facing)}`);
     const arkit: Target[] = [];
     const visemes: Target[] = [];
     const names = new Set<string>();
@@ -91,9 +111,11 @@ export class GltfAvatar {
       }
     });
     if (!arkit.length && !visemes.length) {
-      const found = names.size ? `its morph targets are: ${[...names].slice(0, 60).join(', ')}${names.size > 60 ? ', …' : ''}` : 'it has no morph targets at all';
+      const found = names.size
+        ? `its morph targets are: ${[...names].slice(0, 60).join(', ')}${names.size > 60 ? ', …' : ''}. Rename them`
+        : 'it has no morph targets at all: export it with its blend shapes (shape keys), named so';
       throw new AvatarLoadError(`${source} has no morph targets named after ARKit's 52 blend shapes (jawOpen, eyeBlinkLeft, …) ` +
-        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …); ${found}. Rename them (docs/embedding.md, "Avatars").`);
+        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …); ${found} (docs/embedding.md, "Avatars").`);
     }
     // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
     const arkitMouth = arkit.some((t) => /^(jaw|mouth)/.test(ARKIT_NAMES[t.channel]));
@@ -103,7 +125,7 @@ export class GltfAvatar {
     const matched = [...new Set(targets.map((t) => all[t.channel]))];
     const blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
       .map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
-    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone), blinks);
+    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone), blinks, facing);
   }
 
   get summary(): AvatarSummary {
@@ -136,6 +158,7 @@ export class GltfAvatar {
     this.modelBlink.fill(0);
     this.applyBlink();
     this.head?.quaternion.copy(this.rest);
+    this.onTopActive = false;
   }
 
   private applyBlink(): void {
@@ -149,17 +172,31 @@ export class GltfAvatar {
    * through the parent's rotation relative to gltf.scene, read at each call, so an avatar placed, turned or
    * re-parented before or after binding nods about its own x axis.
    *
-   * `onTop`: on top of the bone's rotation as it is now, not its rest: for a page whose own animation (an
-   * AnimationMixer) sets the head bone every frame, called once per frame after it (else the turns add up).
+   * An avatar bound `facing: '-z'` turns as if it faced +z (a nod is still a nod).
+   *
+   * `onTop`: on top of the bone's rotation as the page's own animation (an AnimationMixer) last set it, not its rest:
+   * call it after the animation's update. Where nothing has set the bone since the last call (no clip on it, a clip
+   * stopped or ended, two calls in one frame), the turn goes on top of the same rotation as then, so turns never add up.
    */
   setHeadRotation(rx: number, ry: number, rz: number, onTop = false): void {
     if (!this.head) return;
+    const flip = this.facing === '-z' ? -1 : 1; // the avatar's axes turned half round y: x and z change sign
+    rx *= flip;
+    rz *= flip;
     const angle = Math.hypot(rx, ry, rz);
     if (angle < 1e-9) scratch.identity();
     else scratch.setFromAxisAngle(axis.set(rx / angle, ry / angle, rz / angle), angle);
     const parent = parentInScene(this.head, this.gltf.scene);
     scratch.premultiply(inverse.copy(parent).invert()).multiply(parent); // parent^-1 * delta * parent
-    this.head.quaternion.multiplyQuaternions(scratch, onTop ? this.head.quaternion : this.rest); // (reads both before it writes)
+    const q = this.head.quaternion;
+    if (onTop) {
+      if (!(this.onTopActive && q.equals(this.onTopWritten))) this.onTopBase.copy(q); // the animation set it since
+      q.multiplyQuaternions(scratch, this.onTopBase);
+      this.onTopWritten.copy(q);
+    } else {
+      q.multiplyQuaternions(scratch, this.rest);
+    }
+    this.onTopActive = onTop;
   }
 }
 
@@ -207,7 +244,7 @@ function findHead(scene: THREE.Object3D, source: string, name?: string | null): 
     if (!found) {
       const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
       const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);
-      throw new AvatarLoadError(`${source} has no node named "${name}" (avatar-head-bone); ` +
+      throw new AvatarLoadError(`${source} has no node named "${name}" (the head bone asked for: avatar-head-bone, or bind's headBone); ` +
         `its ${bones.length ? 'bones' : 'nodes'} are: ${named.slice(0, 60).join(', ')}`);
     }
     return found;

@@ -14,6 +14,16 @@ export function backendAttribute(value: string | null): 'auto' | Backend {
   }
 }
 
+/**
+ * How the `avatar` is bound: `avatar-head-bone` (the node turned with the head; default Head or head) and
+ * `avatar-facing` (+z, glTF's convention and the default, or -z: VRM 0.x; another value warns and means +z).
+ */
+export function avatarAttributes(el: Element): { headBone: string | null; facing: '+z' | '-z' } {
+  const v = el.getAttribute('avatar-facing')?.trim() ?? '';
+  if (v && v !== '+z' && v !== '-z') console.warn(`<talking-face> avatar-facing="${v}" is not +z or -z; using +z (glTF's convention)`);
+  return { headBone: el.getAttribute('avatar-head-bone'), facing: v === '-z' ? '-z' : '+z' };
+}
+
 /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
 export function headMotionAttribute(value: string | null): number | undefined {
   const v = value?.trim(), x = Number(v);

@@ -24,6 +24,8 @@ export interface TalkingFaceAttributes {
   /** URL of a glTF avatar (.glb or .gltf) to drive instead of the built-in face. */
   avatar?: string;
   'avatar-head-bone'?: string;
+  /** Which way the avatar's face looks: +z (glTF's convention, default) or -z (VRM 0.x). */
+  'avatar-facing'?: '+z' | '-z';
   /** `frame` events carry ARKit weights, visemes and the head rotation without an avatar. */
   blendshapes?: boolean;
   /** How far the head's own motion turns the head, 0 to 3 (default 1). */

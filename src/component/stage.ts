@@ -28,7 +28,7 @@ export class ElementStage {
    * shown, false if superseded meanwhile (drop(), another make(), the element removed); rejects with a message for
    * a person (kept in `error`).
    */
-  async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, headBone: string | null): Promise<boolean> {
+  async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, bound: { headBone: string | null; facing: '+z' | '-z' }): Promise<boolean> {
     const token = (this.token = {});
     const root = this.canvas.getRootNode() as ShadowRoot; // the element's
     const canvas = newCanvas(root.host);
@@ -40,7 +40,7 @@ export class ElementStage {
     // Only while its view is shown: a dropped view's context is given up on purpose (dispose), and that is no loss.
     canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.view && this.onContext(true));
     canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.view && this.onContext(false));
-    const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, headBone)
+    const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, bound.headBone, { facing: bound.facing })
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;
     let view: FaceView | AvatarView;

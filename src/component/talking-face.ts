@@ -5,14 +5,14 @@
  *   <talking-face src="/hello.wav" autoplay></talking-face>
  *
  * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
- * avatar-head-bone, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop(), recordVideo().
+ * avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop(), recordVideo().
  * Events: ready, frame, ended, error (detail.message is written for a person). Instances with the same model and backend share one engine.
  */
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { backendAttribute, frameOptions } from './attributes';
+import { avatarAttributes, backendAttribute, frameOptions } from './attributes';
 import { makeTake, TakeError, type ElementTake } from './take';
 import { shadowParts } from './parts';
 import { ElementStage } from './stage';
@@ -31,7 +31,7 @@ export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 const ElementBase = (typeof HTMLElement === 'undefined' ? class {} : HTMLElement) as typeof HTMLElement;
 
 export class TalkingFaceElement extends ElementBase {
-  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone'];
+  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone', 'avatar-facing'];
 
   private readonly statusLine: HTMLParagraphElement;
   private readonly announcer: HTMLElement;
@@ -283,7 +283,7 @@ export class TalkingFaceElement extends ElementBase {
       const avatar = this.getAttribute('avatar');
       if (avatar) this.setStatus('Loading the avatar…');
       try {
-        if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, this.getAttribute('avatar-head-bone')))) return; // superseded
+        if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, avatarAttributes(this)))) return; // superseded
       } catch (e) {
         this.fail(avatar ? 'avatar' : 'model', (e as Error).message);
         return;

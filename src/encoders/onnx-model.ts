@@ -35,6 +35,8 @@ export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
 }
 
 const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
+/** Whether the page has said that onnxruntime's worker failed and the sessions run in the page. */
+let warnedWorkerFailure = false;
 
 /**
  * onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker).
@@ -154,7 +156,8 @@ export class OnnxModel {
         throw error;
       }
       if (!worker.failed) throw e; // the model's own error (the page would give the same)
-      console.warn(`onnxruntime's worker failed (${(e as Error).message}); ${spec.name} runs in the page`);
+      if (!warnedWorkerFailure) console.warn(`onnxruntime's worker failed (${(e as Error).message}); the encoders run in the page`);
+      warnedWorkerFailure = true; // once, not once per session
       return PageRunner.create(spec, provider);
     }
   }

@@ -12,6 +12,8 @@ export const SPEECH_LEVEL = 0.003;
 export const NOISE_FLATNESS = 0.25;
 /** A frame is speech-like when its speech probability exceeds this. */
 export const SPEECH_PROBABILITY = 0.5;
+/** Live frames without speech after which a face goes back to rest (the player's, an avatar driver's): a breath between words does not. */
+export const LIVE_REST_FRAMES = 12;
 /** A clip holds speech when it has this many seconds of speech-like frames ... */
 export const MIN_SPEECH_SECONDS = 0.15;
 /** ... and no single heard phone takes more than this share of them (a steady sound is not speech). */

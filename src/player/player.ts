@@ -6,7 +6,7 @@
 import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
 import { SILENT_PEAK, levels } from '../audio/decode';
-import { SPEECH_PROBABILITY } from '../encoders/voice-activity';
+import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -73,8 +73,6 @@ export interface PlayerOptions {
 
 /** How long a resumed audio context may take to run before it counts as held back by the autoplay rules. */
 const AUTOPLAY_WAIT_MS = 300;
-/** Live frames without speech after which the face goes back to rest (showLive): a breath between words does not. */
-const LIVE_REST_FRAMES = 12;
 /**
  * Live frames come in batches when the device is slow (a batch per engine run): they are shown one after another,
  * each this fraction of a frame's time after the last (a little faster than real time, so a backlog drains) ...

@@ -167,10 +167,17 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
 
 /** The test avatar with its morph targets renamed (the JSON chunk of the .glb edited, the binary chunk kept). */
 function renamedAvatar(rename: (name: string) => string): string {
-  const b = readFileSync(resolve(AVATARS, 'visemes-face.glb'));
+  return editedAvatar('visemes-face.glb', (gltf) => {
+    for (const mesh of gltf.meshes) if (mesh.extras?.targetNames) mesh.extras.targetNames = mesh.extras.targetNames.map(rename);
+  });
+}
+
+/** A test avatar (base64) with its glTF JSON changed by `edit`. */
+function editedAvatar(file: string, edit: (gltf: any) => void): string {
+  const b = readFileSync(resolve(AVATARS, file));
   const jsonLength = b.readUInt32LE(12);
   const gltf = JSON.parse(b.subarray(20, 20 + jsonLength).toString());
-  for (const mesh of gltf.meshes) if (mesh.extras?.targetNames) mesh.extras.targetNames = mesh.extras.targetNames.map(rename);
+  edit(gltf);
   let text = JSON.stringify(gltf);
   while (text.length % 4) text += ' ';
   const json = Buffer.from(text);
@@ -204,9 +211,50 @@ test('an avatar file that is not glTF, or has neither naming scheme, gives a cle
   const unnamed = await errorOf(await blobUrl(renamedAvatar((n) => n.replace('viseme_', 'mouth_shape_'))));
   expect(unnamed).toMatch(/no morph targets named after ARKit's 52 blend shapes .* or the 15 Oculus visemes/);
   expect(unnamed).toContain('its morph targets are: mouth_shape_sil, mouth_shape_PP, mouth_shape_FF');
-  expect(await errorOf('/examples/avatars/arkit-face.glb', 'Neck')).toMatch(/no node named "Neck" \(avatar-head-bone\); its nodes are: Head, face_arkit/);
+  expect(await errorOf('/examples/avatars/arkit-face.glb', 'Neck')).toMatch(/no node named "Neck" \(the head bone asked for: avatar-head-bone, or bind's headBone\); its nodes are: Head, face_arkit/);
   // Exporter prefixes and other spellings still match: "blendShape1.viseme_PP", "Viseme_AA".
   const prefixed = await errorOf(await blobUrl(renamedAvatar((n) => (n === 'viseme_aa' ? 'Viseme_AA' : `blendShape1.${n}`))));
   expect(prefixed).toMatch(/^ready: .*"scheme":"visemes"/);
   expect(JSON.parse(prefixed.slice('ready: '.length)).matched).toHaveLength(15);
+});
+
+test('avatar-facing="-z" shows an avatar made facing -z (VRM 0.x) as a +z one', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.emulateMedia({ reducedMotion: 'reduce' }); // no idle blinks: the pictures compare as they are
+  await page.goto('/examples/embed.html');
+  // The ARKit test avatar turned half round y at its root: its face looks towards -z.
+  const turned = editedAvatar('arkit-face.glb', (gltf) => { for (const n of gltf.scenes[0].nodes) gltf.nodes[n].rotation = [0, 1, 0, 0]; });
+  const url = await page.evaluate((data) => URL.createObjectURL(new Blob([Uint8Array.from(atob(data), (c) => c.charCodeAt(0))])), turned);
+  const shot = async (avatar: string, facing: string | null) => {
+    await page.evaluate(([a, f]) => new Promise<void>((resolve, reject) => {
+      document.querySelectorAll('talking-face').forEach((e) => e.remove());
+      const el = document.createElement('talking-face');
+      Object.assign(el.style, { width: '320px', height: '320px', display: 'block' });
+      el.setAttribute('backend', 'cpu');
+      el.setAttribute('hide-status', '');
+      el.setAttribute('avatar', a);
+      if (f) el.setAttribute('avatar-facing', f);
+      el.addEventListener('ready', () => setTimeout(resolve, 500)); // the rest's weights set, then drawn
+      el.addEventListener('error', (e) => reject(new Error((e as CustomEvent).detail.message)));
+      document.body.prepend(el);
+    }), [avatar, facing] as const);
+    return page.locator('talking-face').screenshot();
+  };
+  const plain = await shot('/examples/avatars/arkit-face.glb', null);
+  const fixed = await shot(url, '-z');
+  const away = await shot(url, null);
+  const differing = (a: Buffer, b: Buffer) => page.evaluate(async ([x, y]) => {
+    const pixels = async (b64: string) => {
+      const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+      const c = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d')!;
+      c.drawImage(bmp, 0, 0);
+      return c.getImageData(0, 0, bmp.width, bmp.height).data;
+    };
+    const [p, q] = [await pixels(x), await pixels(y)];
+    let n = 0;
+    for (let i = 0; i < p.length; i += 4) if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 24) n++;
+    return n / (p.length / 4);
+  }, [a.toString('base64'), b.toString('base64')] as const);
+  expect(await differing(plain, fixed), 'turned back to the camera: the same picture').toBeLessThan(0.002);
+  expect(await differing(plain, away), 'without the attribute: its back').toBeGreaterThan(0.05);
 });

@@ -28,6 +28,9 @@ test('without Web Workers the encoders run in the page', async ({ page }) => {
 test('where onnxruntime worker cannot load, the encoders fall back to the page', async ({ page, guard }) => {
   await page.route(/onnx-worker[^/]*\.js$/, (route) => route.fulfill({ status: 404, body: 'not found' }));
   guard.allowConsoleError(/onnx-worker|404|Not Found/i);
+  const warnings: string[] = [];
+  page.on('console', (m) => { if (m.type() === 'warning' && /onnxruntime's worker/.test(m.text())) warnings.push(m.text()); });
   await page.goto('/');
   await animate(page);
+  expect(warnings, 'said once, not once per session').toHaveLength(1);
 });

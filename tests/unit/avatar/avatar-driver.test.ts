@@ -9,6 +9,7 @@ import { resolve } from 'node:path';
 import * as THREE from 'three';
 import { GltfAvatar } from '../../../src/avatar/gltf-avatar';
 import { AvatarDriver, BLEND_IN_SECONDS, BLEND_OUT_SECONDS } from '../../../src/avatar/avatar-driver';
+import { LIVE_REST_FRAMES } from '../../../src/encoders/voice-activity';
 import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES } from '../../../src/avatar/names';
 import { ROOT } from '../helpers/exported';
 
@@ -107,5 +108,43 @@ describe('AvatarDriver', () => {
       const want = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.2).multiply(animated);
       expect(head.quaternion.angleTo(want), `at ${now} ms`).toBeLessThan(1e-6);
     }
+  });
+
+  it('goes back to rest after LIVE_REST_FRAMES live frames without speech, and speaks again when speech comes', () => {
+    const t = { ...take(), speech: Float32Array.from([0, 0.9]) }; // frame 0 quiet, frame 1 speech
+    driver.showLive(t, 0);
+    driver.update(0);
+    driver.update(1000);
+    expect(driver.speechWeight, 'no speech heard yet: at rest').toBe(0);
+    driver.showLive(t, 1);
+    driver.update(2000);
+    driver.update(3000);
+    expect(driver.speechWeight).toBe(1);
+    for (let k = 1; k < LIVE_REST_FRAMES; k++) driver.showLive(t, 0); // a breath between words
+    driver.update(4000);
+    expect(driver.speechWeight).toBe(1);
+    driver.showLive(t, 0); // the LIVE_REST_FRAMES-th quiet frame
+    driver.update(5000);
+    driver.update(6000);
+    expect(driver.speechWeight).toBe(0);
+    driver.showLive(t, 1);
+    driver.update(7000);
+    driver.update(8000);
+    expect(driver.speechWeight).toBe(1);
+  });
+
+  it('with headOnTop and nothing animating the head, the turn stays one turn and goes when speech ends', () => {
+    driver.headOnTop = true;
+    const head = avatar.head!, rest = head.quaternion.clone(), t = take();
+    driver.show(t, 1);
+    for (let ms = 0; ms <= 1000; ms += 100) driver.update(ms); // no clip sets the bone between updates
+    expect(head.quaternion.angleTo(rest)).toBeCloseTo(0.2, 5);
+    driver.setSpeaking(false);
+    for (let ms = 1000; ms <= 2000; ms += 100) driver.update(ms);
+    expect(head.quaternion.angleTo(rest)).toBeLessThan(1e-6);
+  });
+
+  it('says what it takes when given something else', () => {
+    expect(() => new AvatarDriver({ scene: {} } as never)).toThrow(/AvatarDriver takes a GltfAvatar: new AvatarDriver\(GltfAvatar\.bind\(gltf, name\)\)/);
   });
 });

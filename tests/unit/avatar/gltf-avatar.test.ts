@@ -106,7 +106,10 @@ describe('GltfAvatar', () => {
 
   it('says what it found when neither scheme is there, and when the file is not glTF', async () => {
     expect(() => GltfAvatar.bind(fake(['smile', 'blink', 'A']), 'face.glb')).toThrow(/face\.glb has no morph targets named after ARKit's 52 .* its morph targets are: smile, blink, A\./);
-    expect(() => GltfAvatar.bind(fake([]), 'bare.glb')).toThrow(/it has no morph targets at all/);
+    expect(() => GltfAvatar.bind(fake([]), 'bare.glb')).toThrow(/it has no morph targets at all: export it with its blend shapes \(shape keys\), named so/);
+    // The loader's scene instead of its result, and a facing that is not one.
+    expect(() => GltfAvatar.bind(fake(['jawOpen']).scene as never, 'me.glb')).toThrow(/give what GLTFLoader gave \(gltf\), not its scene/);
+    expect(() => GltfAvatar.bind(fake(['jawOpen']), 'me.glb', null, { facing: 'z' as never })).toThrow(/facing is '\+z' or '-z', not "z"/);
     await expect(GltfAvatar.parse(new TextEncoder().encode('ID3\u0004 an mp3').buffer as ArrayBuffer, 'song.mp3')).rejects.toThrow(/song\.mp3 is not a glTF file .*starts with "ID3/);
     for (const page of ['<!doctype html><html></html>', '\ufeff\n<html>']) { // a host's page for a missing file, a byte-order mark or not
       await expect(GltfAvatar.parse(new TextEncoder().encode(page).buffer as ArrayBuffer, 'me.glb')).rejects.toThrow(/^me\.glb is not a glTF file but an HTML page, as hosts send for a missing file: is the URL right\?$/);
@@ -127,7 +130,7 @@ describe('GltfAvatar', () => {
     expect(GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck', 'Skull']), 'x.glb', 'Skull').summary.headBone).toBe('Skull');
     // Named as in the file: three.js's loader drops ':' and '.' from node names (mixamorig:Head -> mixamorigHead).
     expect(GltfAvatar.bind(fake(['jawOpen'], ['mixamorigHips', 'mixamorigHead']), 'x.glb', 'mixamorig:Head').summary.headBone).toBe('mixamorigHead');
-    expect(() => GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck']), 'x.glb', 'Skull')).toThrow(/no node named "Skull" \(avatar-head-bone\); its bones are: Hips, Neck/);
+    expect(() => GltfAvatar.bind(fake(['jawOpen'], ['Hips', 'Neck']), 'x.glb', 'Skull')).toThrow(/no node named "Skull" \(the head bone asked for: avatar-head-bone, or bind's headBone\); its bones are: Hips, Neck/);
   });
 
   it("turns the head about its pivot by a rotation given in world axes, whatever its parent's rotation", () => {
@@ -166,5 +169,48 @@ describe('GltfAvatar', () => {
       const want = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.3).multiply(rest);
       expect(inScene().angleTo(want), when).toBeLessThan(1e-6);
     }
+  });
+
+  it("nods a -z facing avatar (VRM 0.x) as a +z one when bound facing: '-z'", () => {
+    // The same rig twice, the second with its face towards -z, as a VRM 0.x model is made.
+    const made = (turned: boolean) => {
+      const gltf = fake(['jawOpen'], ['Hips', 'Head']);
+      const head = gltf.scene.getObjectByName('Head')!;
+      const nose = new THREE.Object3D(); // a point in front of the face
+      nose.position.set(0, 0, turned ? -1 : 1);
+      head.add(nose);
+      return { gltf, nose };
+    };
+    const plain = made(false), vrm = made(true);
+    const a = GltfAvatar.bind(plain.gltf, 'a.glb'), b = GltfAvatar.bind(vrm.gltf, 'b.vrm', null, { facing: '-z' });
+    expect(b.facing).toBe('-z');
+    a.setHeadRotation(0.3, 0.2, 0.1);
+    b.setHeadRotation(0.3, 0.2, 0.1);
+    const at = (o: THREE.Object3D) => { o.updateWorldMatrix(true, false); return o.getWorldPosition(new THREE.Vector3()); };
+    const p = at(plain.nose), q = at(vrm.nose);
+    expect(p.y).toBeLessThan(-0.2); // the nose goes down in a nod
+    // The -z face moves as the +z one, mirrored through the y axis (its nose at -z).
+    expect([q.x, q.y, q.z].map((v) => v.toFixed(6))).toEqual([-p.x, p.y, -p.z].map((v) => v.toFixed(6)));
+  });
+
+  it('puts the turn on top of the animated head bone, and never adds turns up where nothing animates it', () => {
+    const gltf = fake(['jawOpen'], ['Hips', 'Head']);
+    const head = gltf.scene.getObjectByName('Head')!;
+    const a = GltfAvatar.bind(gltf, 'x.glb');
+    const nod = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(1, 0, 0), 0.3);
+    const animated = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(0, 1, 0), 0.5);
+    head.quaternion.copy(animated); // a clip sets the bone
+    a.setHeadRotation(0.3, 0, 0, true);
+    expect(head.quaternion.angleTo(nod.clone().multiply(animated))).toBeLessThan(1e-6);
+    // The clip stopped: nothing sets the bone; frame after frame (and twice in one), the turn stays one turn.
+    for (let k = 0; k < 5; k++) a.setHeadRotation(0.3, 0, 0, true);
+    expect(head.quaternion.angleTo(nod.clone().multiply(animated))).toBeLessThan(1e-6);
+    a.setHeadRotation(0, 0, 0, true); // and a zero turn gives the clip's rotation back
+    expect(head.quaternion.angleTo(animated)).toBeLessThan(1e-6);
+    // The clip sets it again, elsewhere: the turn goes on top of that.
+    const later = new THREE.Quaternion().setFromAxisAngle(new THREE.Vector3(0, 1, 0), -0.2);
+    head.quaternion.copy(later);
+    a.setHeadRotation(0.3, 0, 0, true);
+    expect(head.quaternion.angleTo(nod.clone().multiply(later))).toBeLessThan(1e-6);
   });
 });
