@@ -22,6 +22,8 @@ test('npm pack holds the library, its declarations, the runtime and the model, a
   for (const key of manifest.runtime_files) expect(files, manifest.files[key]).toContain(`dist/models/${manifest.files[key]}`);
   expect([...files].some((f) => f.startsWith('dist/ort/') && f.endsWith('ort-wasm-simd-threaded.wasm'))).toBe(true);
   expect([...files].filter((f) => /checkpoint\.pt|fixtures|samples\/|^training\/|^tests\/|^src\//.test(f))).toEqual([]);
+  // Nor the precompressed copies the build writes for hosting it (.br, .gz: 24 MB): a project's own host compresses.
+  expect([...files].filter((f) => /\.(br|gz)$/.test(f))).toEqual([]);
 });
 
 test('imports where there is no DOM, with three.js its importer\'s', () => {
