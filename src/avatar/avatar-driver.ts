@@ -102,8 +102,9 @@ export class AvatarDriver {
 
   /** Frame `frame` of the blend-shape output onto the avatar's morph targets. */
   setBlendshapes(b: BlendshapeFrames, frame: number): void {
-    this.shown.arkit.set(b.arkit.subarray(frame * ARKIT_NAMES.length, (frame + 1) * ARKIT_NAMES.length));
-    this.shown.visemes.set(b.visemes.subarray(frame * VISEME_NAMES.length, (frame + 1) * VISEME_NAMES.length));
+    const { arkit, visemes } = this.shown, A = arkit.length, V = visemes.length;
+    for (let k = 0; k < A; k++) arkit[k] = b.arkit[frame * A + k]; // (copied by index: a subarray view per frame is an allocation)
+    for (let k = 0; k < V; k++) visemes[k] = b.visemes[frame * V + k];
     if (this.speech >= 1) this.avatar.setWeights(b.arkit, frame * ARKIT_NAMES.length, b.visemes, frame * VISEME_NAMES.length);
     else this.blend();
   }

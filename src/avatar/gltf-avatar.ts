@@ -38,10 +38,11 @@ export interface AvatarBindOptions {
 
 export class GltfAvatar {
   private readonly rest = new THREE.Quaternion();
-  /** setHeadRotation's `onTop`: the rotation it turned (the page's animation of the bone) and the one it wrote. */
+  /** setHeadRotation's `onTop`: the rotation it turned (the page's animation of the bone). */
   private readonly onTopBase = new THREE.Quaternion();
-  private readonly onTopWritten = new THREE.Quaternion();
-  private onTopActive = false;
+  /** The head bone's rotation as setHeadRotation last wrote it, and how (null: not since binding or reset). */
+  private readonly written = new THREE.Quaternion();
+  private wroteOnTop: boolean | null = null;
 
   /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
   private readonly modelBlink = [0, 0];
@@ -152,13 +153,18 @@ export class GltfAvatar {
     this.applyBlink();
   }
 
-  /** Every driven morph target back to 0 and the head to its rest pose. */
+  /**
+   * Every driven morph target back to 0 and the head to its rest pose: after turns on top of the page's animation,
+   * the animation's rotation they turned (the page's, where it has set the bone since).
+   */
   reset(): void {
     for (const t of this.targets) t.influences[t.at] = 0;
     this.modelBlink.fill(0);
     this.applyBlink();
-    this.head?.quaternion.copy(this.rest);
-    this.onTopActive = false;
+    const q = this.head?.quaternion;
+    if (q && !this.wroteOnTop) q.copy(this.rest);
+    else if (q && q.equals(this.written)) q.copy(this.onTopBase);
+    this.wroteOnTop = null;
   }
 
   private applyBlink(): void {
@@ -176,7 +182,8 @@ export class GltfAvatar {
    *
    * `onTop`: on top of the bone's rotation as the page's own animation (an AnimationMixer) last set it, not its rest:
    * call it after the animation's update. Where nothing has set the bone since the last call (no clip on it, a clip
-   * stopped or ended, two calls in one frame), the turn goes on top of the same rotation as then, so turns never add up.
+   * stopped or ended, two calls in one frame), the turn goes on top of the same rotation as then, so turns never add up
+   * (after a call without `onTop`, on top of the rest).
    */
   setHeadRotation(rx: number, ry: number, rz: number, onTop = false): void {
     if (!this.head) return;
@@ -190,13 +197,13 @@ export class GltfAvatar {
     scratch.premultiply(inverse.copy(parent).invert()).multiply(parent); // parent^-1 * delta * parent
     const q = this.head.quaternion;
     if (onTop) {
-      if (!(this.onTopActive && q.equals(this.onTopWritten))) this.onTopBase.copy(q); // the animation set it since
-      q.multiplyQuaternions(scratch, this.onTopBase);
-      this.onTopWritten.copy(q);
-    } else {
-      q.multiplyQuaternions(scratch, this.rest);
+      const untouched = this.wroteOnTop !== null && q.equals(this.written); // nothing has set the bone since
+      if (!untouched) this.onTopBase.copy(q); // the animation's rotation now
+      else if (!this.wroteOnTop) this.onTopBase.copy(this.rest); // the last turn was on top of the rest
     }
-    this.onTopActive = onTop;
+    q.multiplyQuaternions(scratch, onTop ? this.onTopBase : this.rest);
+    this.written.copy(q);
+    this.wroteOnTop = onTop;
   }
 }
 

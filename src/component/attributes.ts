@@ -24,6 +24,20 @@ export function avatarAttributes(el: Element): { headBone: string | null; facing
   return { headBone: el.getAttribute('avatar-head-bone'), facing: v === '-z' ? '-z' : '+z' };
 }
 
+/**
+ * Whether a boolean attribute is on: present, and not "false" (React 18 writes `autoplay={false}` as
+ * autoplay="false"; the HTML way, absent, is off too).
+ */
+export function isOn(value: string | null): boolean {
+  return value !== null && value.trim().toLowerCase() !== 'false';
+}
+
+/** A property that reflects its attribute: a string sets it, null or undefined removes it. */
+export function reflect(el: Element, name: string, value: string | null | undefined): void {
+  if (value == null) el.removeAttribute(name);
+  else el.setAttribute(name, String(value));
+}
+
 /** The `head-motion` attribute for the next animation or session (one outside 0-3 warns and is ignored). */
 export function headMotionAttribute(value: string | null): number | undefined {
   const v = value?.trim(), x = Number(v);
@@ -37,7 +51,7 @@ export function headMotionAttribute(value: string | null): number | undefined {
  * page asks (`blendshapes`); the head's own motion's scale (`head-motion`), read at each speak() and startMicrophone().
  */
 export function frameOptions(el: Element): { blendshapes: boolean; headMotionScale: number | undefined } {
-  return { blendshapes: el.hasAttribute('avatar') || el.hasAttribute('blendshapes'), headMotionScale: headMotionAttribute(el.getAttribute('head-motion')) };
+  return { blendshapes: el.hasAttribute('avatar') || isOn(el.getAttribute('blendshapes')), headMotionScale: headMotionAttribute(el.getAttribute('head-motion')) };
 }
 
 /** A URL as a person wrote it ("Grüße.wav", not "Gr%C3%BC%C3%9Fe.wav"); as it is where it holds a malformed %-sequence. */

@@ -9,7 +9,7 @@ canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
 .status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45);
   text-align: start; text-transform: none; text-indent: 0; letter-spacing: normal; word-spacing: normal; white-space: normal; } /* not the page's */
 .status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
-:host([hide-status]) .status:not(.error) { display: none; } /* the announcer still speaks */
+:host([hide-status]:not([hide-status="false"])) .status:not(.error) { display: none; } /* the announcer still speaks */
 .announce { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 `;
 
@@ -34,7 +34,7 @@ export function newCanvas(host: Element): HTMLCanvasElement {
  * only (loading, ready, playing, stopped, errors): the status line's progress ("frame 96 of 480") would be spoken
  * at every chunk.
  */
-export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; status: HTMLParagraphElement; announcer: HTMLElement } {
+export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; status: StatusLine } {
   const root = host.attachShadow({ mode: 'open' });
   // A group by default, so that a page may name the element (aria-label, which its canvas also takes).
   const internals = host.attachInternals?.();
@@ -52,7 +52,19 @@ export function shadowParts(host: HTMLElement): { canvas: HTMLCanvasElement; sta
   announcer.setAttribute('aria-live', 'polite');
   root.append(canvas, status, announcer);
   adoptStyle(root);
-  return { canvas, status, announcer };
+  return { canvas, status: new StatusLine(status, announcer) };
+}
+
+/** The status line, and the live region that says its changes of state to screen readers. */
+export class StatusLine {
+  constructor(private readonly line: HTMLParagraphElement, private readonly announcer: HTMLElement) {}
+
+  /** Show `text`; `announce`: a change of state that screen readers hear too (not progress). */
+  set(text: string, isError = false, announce = true): void {
+    this.line.textContent = text;
+    this.line.classList.toggle('error', isError);
+    if (announce && this.announcer.textContent !== text) this.announcer.textContent = text;
+  }
 }
 
 let sheet: CSSStyleSheet | null = null;

@@ -12,9 +12,9 @@ import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { avatarAttributes, backendAttribute, frameOptions } from './attributes';
+import { avatarAttributes, backendAttribute, frameOptions, isOn, reflect } from './attributes';
 import { makeTake, TakeError, type ElementTake } from './take';
-import { shadowParts } from './parts';
+import { shadowParts, type StatusLine } from './parts';
 import { ElementStage } from './stage';
 import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
@@ -33,13 +33,12 @@ const ElementBase = (typeof HTMLElement === 'undefined' ? class {} : HTMLElement
 export class TalkingFaceElement extends ElementBase {
   static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone', 'avatar-facing'];
 
-  private readonly statusLine: HTMLParagraphElement;
-  private readonly announcer: HTMLElement;
+  private readonly status: StatusLine;
   private readonly stage: ElementStage;
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
   private hold: EngineHold | null = null; // on the shared engine (engines.ts): released when removed or switched
-  private live: LiveSession | null = null;
+  #live: LiveSession | null = null; // (# : no `live` property, so a framework sets the `live` attribute, not this)
   private animation: Animation | null = null;
   private computeMs = 0;
   private audioSeconds = 0;
@@ -51,19 +50,19 @@ export class TalkingFaceElement extends ElementBase {
 
   constructor() {
     super();
-    const { canvas, status, announcer } = shadowParts(this);
-    [this.statusLine, this.announcer] = [status, announcer];
+    const { canvas, status } = shadowParts(this);
+    this.status = status;
     this.stage = new ElementStage(canvas, {
       onFrame: (f) => this.playbackFrame(f),
       onEnded: () => {
-        this.setStatus(this.playingStatus.replace(/^Playing/, 'Played')); // the same notes, in the past: it is over
+        this.status.set(this.playingStatus.replace(/^Playing/, 'Played')); // the same notes, in the past: it is over
         this.dispatchEvent(new CustomEvent('ended'));
       },
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
-      onBlocked: () => this.setStatus('Click or press a key to hear it: the browser plays sound only after a gesture.'),
-      onUnblocked: () => this.setStatus(this.playingStatus),
+      onBlocked: () => this.status.set('Click or press a key to hear it: the browser plays sound only after a gesture.'),
+      onUnblocked: () => this.status.set(this.playingStatus),
     }, (lost) => (lost ? this.fail('render', 'the face can no longer be drawn: the browser took its WebGL context (too many 3D views on '
-      + 'the page?); it is drawn again if the browser gives it back') : this.setStatus('The face is drawn again.')));
+      + 'the page?); it is drawn again if the browser gives it back') : this.status.set('The face is drawn again.')));
   }
 
   /** Resolves with the engine once the model is loaded (rejects if it cannot be). */
@@ -71,8 +70,12 @@ export class TalkingFaceElement extends ElementBase {
     return this.load();
   }
 
+  /** The decoder's backend in use (null before the model loads); setting it sets the `backend` attribute. */
   get backend(): Backend | null {
     return this.engine?.backend ?? null;
+  }
+  set backend(value: string | null) {
+    reflect(this, 'backend', value);
   }
 
   /** The last offline animation (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it. */
@@ -83,6 +86,10 @@ export class TalkingFaceElement extends ElementBase {
   /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
   get avatar(): GltfAvatar | null {
     return this.stage.view instanceof AvatarView ? this.stage.view.avatar : null;
+  }
+  /** Setting it sets the `avatar` attribute (its URL; null removes it), as frameworks that set properties do. */
+  set avatar(url: string | null) {
+    reflect(this, 'avatar', url);
   }
 
   connectedCallback(): void {
@@ -120,7 +127,7 @@ export class TalkingFaceElement extends ElementBase {
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
     } else if (name === 'live' && this.engine) {
-      if (value !== null) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
+      if (isOn(value)) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
       else this.stop();
     }
   }
@@ -135,7 +142,7 @@ export class TalkingFaceElement extends ElementBase {
     if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded
     let take: ElementTake;
     try {
-      take = await makeTake(engine, audio, this, signal, (text, announce) => gen === this.generation && this.setStatus(text, false, announce));
+      take = await makeTake(engine, audio, this, signal, (text, announce) => gen === this.generation && this.status.set(text, false, announce));
     } catch (e) {
       if (gen !== this.generation) return; // stopped: the abort is no failure
       throw e instanceof TakeError ? this.fail(e.stage, e.message) : e;
@@ -149,7 +156,7 @@ export class TalkingFaceElement extends ElementBase {
     player.load(take.animation, take.decoded.buffer);
     player.show(0);
     this.playingStatus = take.playing;
-    this.setStatus(this.playingStatus);
+    this.status.set(this.playingStatus);
     await player.play(0);
   }
 
@@ -181,7 +188,7 @@ export class TalkingFaceElement extends ElementBase {
       live = await engine.listen(media, (first: number, frames: Frames) => {
         if (gen !== this.generation || !this.stage.player) return;
         this.stage.player.showLive(frames, engine.fps);
-        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.live?.stream) }));
+        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.#live?.stream) }));
       }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
         onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),
         ...frameOptions(this) });
@@ -195,9 +202,9 @@ export class TalkingFaceElement extends ElementBase {
       for (const t of media.getTracks()) t.stop();
       return;
     }
-    this.live = live;
+    this.#live = live;
     this.work = null;
-    this.setStatus(`Listening (look-ahead ${Math.round(this.live.stream.lookAheadMs)} ms, ${engine.backend})…`);
+    this.status.set(`Listening (look-ahead ${Math.round(this.#live.stream.lookAheadMs)} ms, ${engine.backend})…`);
   }
 
   /**
@@ -224,16 +231,16 @@ export class TalkingFaceElement extends ElementBase {
     cancelled?.abort(); // an animation under way stops at its next chunk
     const wasPlaying = this.stage.player?.isPlaying ?? false;
     this.stage.player?.stop();
-    if (wasPlaying || this.live) {
+    if (wasPlaying || this.#live) {
       (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
       this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
     }
-    if (this.live) {
-      const live = this.live;
-      this.live = null;
-      if (say) this.setStatus('Stopped listening.'); // the microphone is released at once; the take's end follows
+    if (this.#live) {
+      const live = this.#live;
+      this.#live = null;
+      if (say) this.status.set('Stopped listening.'); // the microphone is released at once; the take's end follows
       void live.stop();
-    } else if (say && (wasPlaying || cancelled)) this.setStatus('Stopped.');
+    } else if (say && (wasPlaying || cancelled)) this.status.set('Stopped.');
   }
 
   /** Live listening failed or lost its sound: stopped (the microphone released, the face at rest) and reported. */
@@ -245,7 +252,7 @@ export class TalkingFaceElement extends ElementBase {
   private load(): Promise<TalkingFaceEngine> {
     if (!this.loading) {
       const model = this.getAttribute('model') || DEFAULT_MODEL;
-      this.setStatus('Loading the model…');
+      this.status.set('Loading the model…');
       const hold = (this.hold = holdEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))));
       this.loading = hold.engine.then(
         (engine) => {
@@ -281,7 +288,7 @@ export class TalkingFaceElement extends ElementBase {
     if (!engine || !this.isConnected) return; // removed (or reloading) while the model loaded: nothing to show or start
     if (!this.stage.view) {
       const avatar = this.getAttribute('avatar');
-      if (avatar) this.setStatus('Loading the avatar…');
+      if (avatar) this.status.set('Loading the avatar…');
       try {
         if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, avatarAttributes(this)))) return; // superseded
       } catch (e) {
@@ -295,13 +302,13 @@ export class TalkingFaceElement extends ElementBase {
     const rest = view instanceof AvatarView ? engine.restArkit().then((w) => view.setRest(w))
       : engine.restFace().then((r) => (view as PlayerView | null)?.setRestFace?.(r));
     rest.catch((e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`));
-    this.setStatus(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
+    this.status.set(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', { detail: readyDetail(engine, this.avatar?.summary) }));
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (!start) return;
-    if (this.hasAttribute('live')) void this.startMicrophone().catch(() => undefined); // reported by fail()
-    else if (autoplay && src && this.hasAttribute('autoplay') && !this.work) void this.speak(src).catch(() => undefined); // reported by fail()
+    if (isOn(this.getAttribute('live'))) void this.startMicrophone().catch(() => undefined); // reported by fail()
+    else if (autoplay && src && isOn(this.getAttribute('autoplay')) && !this.work) void this.speak(src).catch(() => undefined); // reported by fail()
   }
 
   /** A frame event for each frame shown while playing. */
@@ -311,17 +318,10 @@ export class TalkingFaceElement extends ElementBase {
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: playbackFrameDetail(this.engine, a, frame, this.computeMs, this.audioSeconds) }));
   }
 
-  /** The status line; `announce`: a change of state that screen readers hear too (not progress). */
-  private setStatus(text: string, isError = false, announce = true): void {
-    this.statusLine.textContent = text;
-    this.statusLine.classList.toggle('error', isError);
-    if (announce && this.announcer.textContent !== text) this.announcer.textContent = text;
-  }
-
   /** Show and dispatch an error; returns it so callers can throw it. */
   private fail(stage: TalkingFaceErrorDetail['stage'], message: string): Error {
     this.work = null; // failed: nothing left for stop() to cancel
-    this.setStatus(message, true);
+    this.status.set(message, true);
     this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
     return new TalkingFaceError(stage, message);
   }

@@ -212,5 +212,15 @@ describe('GltfAvatar', () => {
     head.quaternion.copy(later);
     a.setHeadRotation(0.3, 0, 0, true);
     expect(head.quaternion.angleTo(nod.clone().multiply(later))).toBeLessThan(1e-6);
+    // reset() gives the animation's rotation back, not the bind-time rest (a clip that holds a pose does not set it
+    // again: three's mixer writes only what changes).
+    a.reset();
+    expect(head.quaternion.angleTo(later)).toBeLessThan(1e-6);
+    // A turn without onTop, then one with: one turn, on top of the rest (not on top of the first turn).
+    head.quaternion.identity();
+    const b = GltfAvatar.bind(gltf, 'x.glb');
+    b.setHeadRotation(0.2, 0, 0);
+    b.setHeadRotation(0.2, 0, 0, true);
+    expect(head.quaternion.angleTo(new THREE.Quaternion())).toBeCloseTo(0.2, 6);
   });
 });

@@ -1,5 +1,5 @@
 import { afterEach, describe, expect, it, vi } from 'vitest';
-import { audioInput, backendAttribute, headMotionAttribute } from '../../../src/component/attributes';
+import { audioInput, avatarAttributes, backendAttribute, frameOptions, headMotionAttribute, isOn } from '../../../src/component/attributes';
 
 describe('<talking-face> attributes', () => {
   afterEach(() => vi.unstubAllGlobals());
@@ -13,6 +13,25 @@ describe('<talking-face> attributes', () => {
     expect(warn).not.toHaveBeenCalled();
     expect(backendAttribute('gpu')).toBe('auto');
     expect(warn).toHaveBeenCalledWith(expect.stringContaining('backend="gpu"'));
+    warn.mockRestore();
+  });
+
+  it('a boolean attribute is on when present and not "false" (React 18 writes autoplay={false} as "false")', () => {
+    expect([null, 'false', ' FALSE '].map(isOn)).toEqual([false, false, false]);
+    expect(['', 'true', 'autoplay', 'yes'].map(isOn)).toEqual([true, true, true, true]);
+    const el = (attrs: Record<string, string>) => ({ getAttribute: (n: string) => attrs[n] ?? null, hasAttribute: (n: string) => n in attrs }) as unknown as Element;
+    expect(frameOptions(el({ blendshapes: 'false' })).blendshapes).toBe(false);
+    expect(frameOptions(el({ blendshapes: '' })).blendshapes).toBe(true);
+  });
+
+  it('avatar-facing: +z (default) or -z; anything else warns and means +z', () => {
+    const warn = vi.spyOn(console, 'warn').mockImplementation(() => undefined);
+    const el = (attrs: Record<string, string>) => ({ getAttribute: (n: string) => attrs[n] ?? null }) as unknown as Element;
+    expect(avatarAttributes(el({}))).toEqual({ headBone: null, facing: '+z' });
+    expect(avatarAttributes(el({ 'avatar-facing': '-z', 'avatar-head-bone': 'Skull' }))).toEqual({ headBone: 'Skull', facing: '-z' });
+    expect(warn).not.toHaveBeenCalled();
+    expect(avatarAttributes(el({ 'avatar-facing': 'back' })).facing).toBe('+z');
+    expect(warn).toHaveBeenCalledWith(expect.stringContaining('avatar-facing="back" is not +z or -z'));
     warn.mockRestore();
   });
 

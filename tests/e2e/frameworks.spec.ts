@@ -1,0 +1,66 @@
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { test, expect } from './fixtures';
+
+/**
+ * <talking-face> as frameworks set its attributes. React 19 sets a prop on a custom element as a property where the
+ * element has one (`name in element`), else as an attribute (true: "", false: removed); React 18 writes every prop
+ * as an attribute, false as "false". For every attribute talking-face/jsx declares (src/component/jsx.ts), both
+ * ways: nothing throws (a getter without a setter would, in a module's strict code) and the attribute ends up as the
+ * element reads it. Then React 18's "false": an element with autoplay="false" and hide-status="false" does not play
+ * and shows its status.
+ */
+const JSX = readFileSync(resolve(import.meta.dirname, '../../src/component/jsx.ts'), 'utf8');
+const block = JSX.slice(JSX.indexOf('export interface TalkingFaceAttributes'), JSX.indexOf('declare module'));
+const ATTRIBUTES = [...block.matchAll(/^\s+'?([a-z-]+)'?\?:\s*([^;]+);/gm)].map(([, name, type]) => ({ name, boolean: type.trim() === 'boolean' }));
+
+test('every declared attribute, set as React 19 and React 18 set props, reaches the element as an attribute', async ({ page }) => {
+  expect(ATTRIBUTES.map((a) => a.name)).toEqual(expect.arrayContaining(['src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-facing', 'blendshapes', 'head-motion']));
+  await page.goto('/examples/embed.html');
+  const results = await page.evaluate((attributes) => attributes.map(({ name, boolean }) => {
+    const values: unknown[] = boolean ? [true, false] : [name === 'backend' ? 'cpu' : name === 'avatar-facing' ? '-z' : name === 'head-motion' ? 1.5 : '/x'];
+    const out: string[] = [];
+    for (const value of values) {
+      for (const react of [19, 18]) {
+        const el = document.createElement('talking-face') as unknown as HTMLElement & Record<string, unknown>;
+        try {
+          if (react === 19 && name in el) el[name] = value;
+          else if (react === 19 && value === true) el.setAttribute(name, '');
+          else if (react === 19 && value === false) el.removeAttribute(name);
+          else el.setAttribute(name, String(value));
+          out.push(`${name}=${JSON.stringify(value)} (React ${react}): ${JSON.stringify(el.getAttribute(name))}`);
+        } catch (e) {
+          out.push(`${name}=${JSON.stringify(value)} (React ${react}): threw ${(e as Error).message}`);
+        }
+      }
+    }
+    return out;
+  }), ATTRIBUTES);
+  const expected = ATTRIBUTES.map(({ name, boolean }) => {
+    const value = boolean ? null : name === 'backend' ? 'cpu' : name === 'avatar-facing' ? '-z' : name === 'head-motion' ? '1.5' : '/x';
+    return boolean
+      ? [`${name}=true (React 19): ""`, `${name}=true (React 18): "true"`, `${name}=false (React 19): null`, `${name}=false (React 18): "false"`]
+      : [`${name}=${name === 'head-motion' ? '1.5' : JSON.stringify(value)} (React 19): ${JSON.stringify(value)}`, `${name}=${name === 'head-motion' ? '1.5' : JSON.stringify(value)} (React 18): ${JSON.stringify(value)}`];
+  });
+  expect(results).toEqual(expected);
+});
+
+test('autoplay="false" does not play and hide-status="false" shows the status, as React 18 writes them', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/examples/embed.html');
+  const seen = await page.evaluate(() => new Promise<{ frames: number; status: string; shown: boolean }>((resolve) => {
+    document.querySelectorAll('talking-face').forEach((e) => e.remove());
+    const el = document.createElement('talking-face');
+    for (const [k, v] of [['backend', 'cpu'], ['src', '/examples/sample.wav'], ['autoplay', 'false'], ['hide-status', 'false']]) el.setAttribute(k, v);
+    let frames = 0;
+    el.addEventListener('frame', () => frames++);
+    el.addEventListener('ready', () => setTimeout(() => {
+      const status = el.shadowRoot!.querySelector('.status') as HTMLElement;
+      resolve({ frames, status: status.textContent ?? '', shown: getComputedStyle(status).display !== 'none' });
+    }, 2500));
+    document.body.append(el);
+  }));
+  expect(seen.frames, 'no playback').toBe(0);
+  expect(seen.status).toMatch(/^Ready/);
+  expect(seen.shown, 'the status line shows').toBe(true);
+});
