@@ -6,6 +6,7 @@
  */
 import type * as React from 'react';
 import type { TalkingFaceElement } from './talking-face';
+import type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
 /** The element's attributes (docs/embedding.md, "Attributes"); a boolean one is on when present. */
 export interface TalkingFaceAttributes {
@@ -32,10 +33,24 @@ export interface TalkingFaceAttributes {
   'head-motion'?: number | `${number}`;
 }
 
+/**
+ * The element's events as React 19 listens to them on a custom element: `on` and the event's name as it is
+ * (`onframe`, not `onFrame`). React's own `onError` and `onEnded` are for media and images: on this element they
+ * would never be called, so its type leaves them out.
+ */
+export interface TalkingFaceEventProps {
+  onready?: (event: CustomEvent<ReadyDetail>) => void;
+  onframe?: (event: CustomEvent<FrameDetail>) => void;
+  onended?: (event: Event) => void;
+  onerror?: (event: CustomEvent<TalkingFaceErrorDetail>) => void;
+}
+
+type ReactProps = React.DetailedHTMLProps<React.HTMLAttributes<TalkingFaceElement>, TalkingFaceElement>;
+
 declare module 'react' {
   namespace JSX {
     interface IntrinsicElements {
-      'talking-face': React.DetailedHTMLProps<React.HTMLAttributes<TalkingFaceElement>, TalkingFaceElement> & TalkingFaceAttributes;
+      'talking-face': Omit<ReactProps, 'onError' | 'onErrorCapture' | 'onEnded' | 'onEndedCapture'> & TalkingFaceAttributes & TalkingFaceEventProps;
     }
   }
 }

@@ -116,13 +116,14 @@ export class TalkingFaceElement extends ElementBase {
     if (old === value || !this.isConnected || !this.connected) return;
     if (name === 'model' || name === 'template' || name.startsWith('avatar') || name === 'backend') {
       // Elements share an engine per model, template and backend: a new backend takes the engine of its backend
-      // (the others keep theirs) and keeps its view (and does not autoplay again); `ready` tells the new backend.
+      // (the others keep theirs) and keeps its view; `ready` tells the new backend. Only another model or template
+      // autoplays `src` again (another avatar or backend shows the same speech).
       const anew = name !== 'backend';
       this.stop();
       this.letGo();
       this.retrying = false;
       if (anew) this.stage.drop();
-      void this.load().then(() => this.afterLoad(anew), () => undefined); // deliberate: load() reports its failure
+      void this.load().then(() => this.afterLoad(name === 'model' || name === 'template'), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value) { // set while the model loads: spoken once it is in
       // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)

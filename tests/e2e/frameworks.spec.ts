@@ -8,10 +8,11 @@ import { test, expect } from './fixtures';
  * as an attribute, false as "false". For every attribute talking-face/jsx declares (src/component/jsx.ts), both
  * ways: nothing throws (a getter without a setter would, in a module's strict code) and the attribute ends up as the
  * element reads it. Then React 18's "false": an element with autoplay="false" and hide-status="false" does not play
- * and shows its status.
+ * and shows its status. And an avatar switched on from state after an autoplayed take does not speak it again.
  */
 const JSX = readFileSync(resolve(import.meta.dirname, '../../src/component/jsx.ts'), 'utf8');
-const block = JSX.slice(JSX.indexOf('export interface TalkingFaceAttributes'), JSX.indexOf('declare module'));
+const start = JSX.indexOf('export interface TalkingFaceAttributes');
+const block = JSX.slice(start, JSX.indexOf('\n}\n', start));
 const ATTRIBUTES = [...block.matchAll(/^\s+'?([a-z-]+)'?\?:\s*([^;]+);/gm)].map(([, name, type]) => ({ name, boolean: type.trim() === 'boolean' }));
 
 test('every declared attribute, set as React 19 and React 18 set props, reaches the element as an attribute', async ({ page }) => {
@@ -63,4 +64,26 @@ test('autoplay="false" does not play and hide-status="false" shows the status, a
   expect(seen.frames, 'no playback').toBe(0);
   expect(seen.status).toMatch(/^Ready/);
   expect(seen.shown, 'the status line shows').toBe(true);
+});
+
+test('another avatar does not speak an autoplayed src again', async ({ page }) => {
+  test.setTimeout(180_000);
+  await page.goto('/examples/embed.html');
+  const framesAfter = await page.evaluate(() => new Promise<number>((resolve, reject) => {
+    document.querySelectorAll('talking-face').forEach((e) => e.remove());
+    const el = document.createElement('talking-face');
+    for (const [k, v] of [['backend', 'cpu'], ['src', '/examples/sample.wav'], ['autoplay', '']]) el.setAttribute(k, v);
+    let frames = 0, switched = false;
+    el.addEventListener('frame', () => frames++);
+    el.addEventListener('error', (e) => reject(new Error((e as CustomEvent).detail.message)));
+    el.addEventListener('ended', () => {
+      if (switched) return resolve(-1); // it played again
+      switched = true;
+      frames = 0;
+      el.addEventListener('ready', () => setTimeout(() => resolve(frames), 3000));
+      el.setAttribute('avatar', '/examples/avatars/arkit-face.glb');
+    });
+    document.body.append(el);
+  }));
+  expect(framesAfter, 'frames played after the avatar came').toBe(0);
 });

@@ -116,7 +116,10 @@ test('talking-face/jsx types the element in React\'s JSX: its attributes, and a 
     'export function Face() {',
     '  const ref = useRef<TalkingFaceElement>(null);',
     '  return (<>',
-    '    <talking-face ref={ref} src="/hello.wav" autoplay backend="cpu" head-motion={1.5} avatar="/me.glb" avatar-head-bone="Head" hide-status className="face" />',
+    '    <talking-face ref={ref} src="/hello.wav" autoplay backend="cpu" head-motion={1.5} avatar="/me.glb" avatar-head-bone="Head" hide-status className="face"',
+    '      onframe={(e) => { const n: number = e.detail.frame; console.log(n); }} onerror={(e) => console.log(e.detail.stage)} onended={() => undefined} />',
+    '    {/* @ts-expect-error: React\'s onError is for media and images: never called on this element */}',
+    '    <talking-face onError={() => undefined} />',
     '    {/* @ts-expect-error: not one of its backends */}',
     '    <talking-face backend="gpu" />',
     '    {/* @ts-expect-error: no such attribute */}',
@@ -127,6 +130,9 @@ test('talking-face/jsx types the element in React\'s JSX: its attributes, and a 
   ].join('\n');
   const options = { target: 'es2022', module: 'esnext', moduleResolution: 'bundler', jsx: 'react-jsx', lib: ['es2022', 'dom'], types: [] };
   expect(typecheck({ 'use.tsx': use }, options)).toBe('');
+  // A plain import (not import type) types the same, and resolves to a module that holds nothing.
+  expect(typecheck({ 'use.tsx': use.replace("import type {} from 'talking-face/jsx';", "import 'talking-face/jsx';") }, options)).toBe('');
+  expect(run('node', ['--input-type=module', '-e', "console.log(String(Object.keys(await import('talking-face/jsx')).length))"]).trim()).toBe('0');
   // Without the opt-in, React's JSX does not know the element.
   expect(typecheck({ 'use.tsx': use.replace("import type {} from 'talking-face/jsx';", '') }, options)).toMatch(/Property 'talking-face' does not exist on type 'JSX\.IntrinsicElements'/);
 });
