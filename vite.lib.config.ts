@@ -58,6 +58,9 @@ const forBundlers = defineConfig({
   build: {
     outDir: 'dist/lib/npm',
     emptyOutDir: true,
+    // Not minified: the project's bundler minifies, and until then errors and devtools name the element's class and
+    // its functions as the sources do (minified, <talking-face> was `$`).
+    minify: false,
     target: 'es2022',
     sourcemap: true,
     chunkSizeWarningLimit: 1024,

@@ -28,8 +28,9 @@ test('npm pack holds the library, its declarations, the runtime and the model, a
 
 test('imports where there is no DOM, with three.js its importer\'s', () => {
   const out = run('node', ['--input-type=module', '-e',
-    "const m = await import('talking-face'); console.log([typeof m.TalkingFaceEngine.load, typeof m.setRuntimeBase, String(globalThis.customElements === undefined)].join(' '))"]);
-  expect(out.trim()).toBe('function function true');
+    "const m = await import('talking-face'); console.log([typeof m.TalkingFaceEngine.load, typeof m.setRuntimeBase, String(globalThis.customElements === undefined), m.TalkingFaceElement.name].join(' '))"]);
+  // (the class keeps its name, not minified away, for errors and devtools: the project's bundler minifies)
+  expect(out.trim()).toBe('function function true TalkingFaceElement');
   const code = readFileSync(join(ROOT, 'dist/lib/npm/talking-face.js'), 'utf8');
   expect(code).toMatch(/from\s*"three"/);
   expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
