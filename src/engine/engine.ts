@@ -40,6 +40,9 @@ export type { EngineOptions, AnimateOptions } from './options';
 
 let markSessionsRequested: () => void = () => undefined;
 
+/** What `backend: 'cpu'` loads with instead of asking for a WebGPU adapter: no GPU for the decoder or the encoders. */
+const CPU_ASKED = { available: false, description: 'not asked for (backend cpu)', adapter: null, info: null };
+
 export class TalkingFaceEngine {
   /**
    * Resolves once load() has asked onnxruntime for every session of the model: where the page can start a worker,
@@ -56,7 +59,8 @@ export class TalkingFaceEngine {
     // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
-    const gpu = detectWebGPU().then((support) => {
+    // Asked for the CPU: no adapter is asked for either (where there is none, the request logs a console warning).
+    const gpu = (options.backend === 'cpu' ? Promise.resolve(CPU_ASKED) : detectWebGPU()).then((support) => {
       const hardwareGpu = isHardwareAdapter(support);
       const providers: ExecutionProvider[] = options.onnxProviders ?? (hardwareGpu ? ['webgpu', 'wasm'] : ['wasm']);
       startOrt(providers, options.stallSeconds); // onnxruntime (its worker, or its script) loads while the files arrive

@@ -8,6 +8,7 @@ export interface EngineOptions extends ArtefactOptions {
   /**
    * 'auto' (default): WebGPU on a hardware adapter, else the CPU decoder. A software fallback adapter
    * (SwiftShader) computes the same numbers, more slowly than the CPU path; ask for 'webgpu' to use it anyway.
+   * 'cpu': no WebGPU adapter is asked for, and the encoders run on WebAssembly too (unless onnxProviders says else).
    */
   backend?: 'auto' | Backend;
   /**

@@ -213,3 +213,25 @@ test('ready says how many threads the work runs on: onnxruntime\'s only where th
   expect(plain.isolated).toBe(false);
   expect(plain.threads.encoders).toBe(1);
 });
+
+test('backend="cpu" asks the browser for no WebGPU adapter (where there is none, asking logs a warning)', async ({ page }) => {
+  await page.addInitScript(() => {
+    const g = globalThis as unknown as { adapterRequests: number };
+    g.adapterRequests = 0;
+    const gpu = navigator.gpu as unknown as { requestAdapter: (...a: unknown[]) => unknown } | undefined;
+    if (!gpu) return;
+    const request = gpu.requestAdapter.bind(gpu);
+    gpu.requestAdapter = (...a: unknown[]) => { g.adapterRequests++; return request(...a); };
+  });
+  await page.goto('/examples/embed.html');
+  const asked = await page.evaluate(() => new Promise<number>((resolve, reject) => {
+    document.querySelectorAll('talking-face').forEach((e) => e.remove());
+    const el = document.createElement('talking-face');
+    el.setAttribute('backend', 'cpu');
+    el.addEventListener('ready', () => resolve((globalThis as unknown as { adapterRequests: number }).adapterRequests));
+    el.addEventListener('error', (e) => reject(new Error((e as CustomEvent).detail.message)));
+    document.body.append(el);
+  }));
+  expect(await page.evaluate(() => 'gpu' in navigator), 'this browser has WebGPU (the test would prove nothing without)').toBe(true);
+  expect(asked).toBe(0);
+});
