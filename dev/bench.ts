@@ -8,7 +8,7 @@ import { ReferenceDecoder } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { fmaModule } from '../src/attention/simd-kernel';
 import { GpuDecoder } from '../src/attention/gpu-decoder';
-import { requestSharedDevice, detectWebGPU } from '../src/gpu/capabilities';
+import { requestSharedDevice, detectWebGPU, isHardwareAdapter } from '../src/gpu/capabilities';
 import { buildAdjacency } from '../src/template/mesh-topology';
 import { renderBench } from './render-bench';
 
@@ -39,7 +39,9 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   result.adapter = gpu.info;
 
   let t = now();
-  const engine = await TalkingFaceEngine.load({ backend: 'cpu' });
+  // The CPU decoder first; the encoders' providers as 'auto' would choose them ('cpu' alone keeps them on WebAssembly
+  // even where the webgpu rows below run on a hardware GPU).
+  const engine = await TalkingFaceEngine.load({ backend: 'cpu', onnxProviders: isHardwareAdapter(gpu) ? ['webgpu', 'wasm'] : ['wasm'] });
   result.model_load_ms = now() - t;
   // What loading the engine fetched (this page's own requests; the decoder workers' scripts are not seen here), and
   // which onnxruntime build: the plain WebAssembly one unless the WebGPU provider is used (issue 18).

@@ -161,9 +161,9 @@ export class GltfAvatar {
     for (const t of this.targets) t.influences[t.at] = 0;
     this.modelBlink.fill(0);
     this.applyBlink();
-    const q = this.head?.quaternion;
-    if (q && !this.wroteOnTop) q.copy(this.rest);
-    else if (q && q.equals(this.written)) q.copy(this.onTopBase);
+    const q = this.head?.quaternion; // (not turned since binding or the last reset: left as the page has it)
+    if (q && this.wroteOnTop === false) q.copy(this.rest);
+    else if (q && this.wroteOnTop && q.equals(this.written)) q.copy(this.onTopBase);
     this.wroteOnTop = null;
   }
 

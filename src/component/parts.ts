@@ -9,7 +9,7 @@ canvas:focus-visible { outline: 3px solid #7ab8ff; outline-offset: -3px; }
 .status { position: absolute; left: 0; right: 0; bottom: 0; margin: 0; padding: 4px 8px; font: 12px/1.4 system-ui, sans-serif; color: #dfe6ee; background: rgba(0, 0, 0, 0.45);
   text-align: start; text-transform: none; text-indent: 0; letter-spacing: normal; word-spacing: normal; white-space: normal; } /* not the page's */
 .status.error { color: #ffd2d2; background: rgba(120, 0, 0, 0.6); }
-:host([hide-status]:not([hide-status="false"])) .status:not(.error) { display: none; } /* the announcer still speaks */
+:host([hide-status]:not([hide-status="false" i])) .status:not(.error) { display: none; } /* the announcer still speaks */
 .announce { position: absolute; width: 1px; height: 1px; overflow: hidden; clip-path: inset(50%); white-space: nowrap; }
 `;
 

@@ -38,7 +38,7 @@ export class TalkingFaceElement extends ElementBase {
   private engine: TalkingFaceEngine | null = null;
   private loading: Promise<TalkingFaceEngine> | null = null;
   private hold: EngineHold | null = null; // on the shared engine (engines.ts): released when removed or switched
-  #live: LiveSession | null = null; // (# : no `live` property, so a framework sets the `live` attribute, not this)
+  private liveSession: LiveSession | null = null; // (not `live`: a framework would set it for the `live` attribute)
   private animation: Animation | null = null;
   private computeMs = 0;
   private audioSeconds = 0;
@@ -47,6 +47,7 @@ export class TalkingFaceElement extends ElementBase {
   private playingStatus = '';
   private connected = false; // connectedCallback has run once
   private retrying = false; // the last load failed: the next to succeed shows the face itself
+  private autoplayed = false; // this model's `src` has been autoplayed (or was not to be): another avatar does not again
 
   constructor() {
     super();
@@ -74,7 +75,7 @@ export class TalkingFaceElement extends ElementBase {
   get backend(): Backend | null {
     return this.engine?.backend ?? null;
   }
-  set backend(value: string | null) {
+  set backend(value: 'auto' | Backend | null) {
     reflect(this, 'backend', value);
   }
 
@@ -116,16 +117,16 @@ export class TalkingFaceElement extends ElementBase {
     if (old === value || !this.isConnected || !this.connected) return;
     if (name === 'model' || name === 'template' || name.startsWith('avatar') || name === 'backend') {
       // Elements share an engine per model, template and backend: a new backend takes the engine of its backend
-      // (the others keep theirs) and keeps its view; `ready` tells the new backend. Only another model or template
-      // autoplays `src` again (another avatar or backend shows the same speech).
+      // (the others keep theirs) and keeps its view; `ready` tells the new backend. Another avatar or backend autoplays
+      // `src` only if it had not been yet (the same speech); another model or template, again.
+      if (name === 'model' || name === 'template') this.autoplayed = false;
       const anew = name !== 'backend';
       this.stop();
       this.letGo();
       this.retrying = false;
       if (anew) this.stage.drop();
-      void this.load().then(() => this.afterLoad(name === 'model' || name === 'template'), () => undefined); // deliberate: load() reports its failure
+      void this.load().then(() => this.afterLoad(!this.autoplayed), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value) { // set while the model loads: spoken once it is in
-      // speak() reports its failure itself (fail(): the status line and an `error` event) before rejecting.
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
     } else if (name === 'live' && this.engine) {
       if (isOn(value)) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
@@ -180,16 +181,13 @@ export class TalkingFaceElement extends ElementBase {
       if (gen !== this.generation) return; // stopped (or removed) while the browser asked: not a failure
       throw this.fail('microphone', (e as Error).message);
     }
-    if (gen !== this.generation) {
-      for (const t of media.getTracks()) t.stop();
-      return;
-    }
+    if (gen !== this.generation) return void media.getTracks().forEach((t) => t.stop()); // stopped while the browser asked
     let live: LiveSession;
     try {
       live = await engine.listen(media, (first: number, frames: Frames) => {
         if (gen !== this.generation || !this.stage.player) return;
         this.stage.player.showLive(frames, engine.fps);
-        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.#live?.stream) }));
+        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.liveSession?.stream) }));
       }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
         onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),
         ...frameOptions(this) });
@@ -203,9 +201,9 @@ export class TalkingFaceElement extends ElementBase {
       for (const t of media.getTracks()) t.stop();
       return;
     }
-    this.#live = live;
+    this.liveSession = live;
     this.work = null;
-    this.status.set(`Listening (look-ahead ${Math.round(this.#live.stream.lookAheadMs)} ms, ${engine.backend})…`);
+    this.status.set(`Listening (look-ahead ${Math.round(this.liveSession.stream.lookAheadMs)} ms, ${engine.backend})…`);
   }
 
   /**
@@ -232,13 +230,13 @@ export class TalkingFaceElement extends ElementBase {
     cancelled?.abort(); // an animation under way stops at its next chunk
     const wasPlaying = this.stage.player?.isPlaying ?? false;
     this.stage.player?.stop();
-    if (wasPlaying || this.#live) {
+    if (wasPlaying || this.liveSession) {
       (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
       this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
     }
-    if (this.#live) {
-      const live = this.#live;
-      this.#live = null;
+    if (this.liveSession) {
+      const live = this.liveSession;
+      this.liveSession = null;
       if (say) this.status.set('Stopped listening.'); // the microphone is released at once; the take's end follows
       void live.stop();
     } else if (say && (wasPlaying || cancelled)) this.status.set('Stopped.');
@@ -308,6 +306,7 @@ export class TalkingFaceElement extends ElementBase {
     const src = this.getAttribute('src');
     // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (!start) return;
+    this.autoplayed ||= autoplay;
     if (isOn(this.getAttribute('live'))) void this.startMicrophone().catch(() => undefined); // reported by fail()
     else if (autoplay && src && isOn(this.getAttribute('autoplay')) && !this.work) void this.speak(src).catch(() => undefined); // reported by fail()
   }

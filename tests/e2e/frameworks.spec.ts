@@ -8,7 +8,8 @@ import { test, expect } from './fixtures';
  * as an attribute, false as "false". For every attribute talking-face/jsx declares (src/component/jsx.ts), both
  * ways: nothing throws (a getter without a setter would, in a module's strict code) and the attribute ends up as the
  * element reads it. Then React 18's "false": an element with autoplay="false" and hide-status="false" does not play
- * and shows its status. And an avatar switched on from state after an autoplayed take does not speak it again.
+ * and shows its status. And an avatar switched on from state after an autoplayed take does not speak it again, while
+ * one set at once after the element is added does not keep it from being autoplayed.
  */
 const JSX = readFileSync(resolve(import.meta.dirname, '../../src/component/jsx.ts'), 'utf8');
 const start = JSX.indexOf('export interface TalkingFaceAttributes');
@@ -80,10 +81,30 @@ test('another avatar does not speak an autoplayed src again', async ({ page }) =
       if (switched) return resolve(-1); // it played again
       switched = true;
       frames = 0;
-      el.addEventListener('ready', () => setTimeout(() => resolve(frames), 3000));
+      // Neither frames nor a take being made (speak() says "Decoding audio…" at once) 3 s after the avatar is shown.
+      el.addEventListener('ready', () => setTimeout(() => {
+        const status = el.shadowRoot!.querySelector('.status')!.textContent ?? '';
+        resolve(/^Ready/.test(status) ? frames : -2);
+      }, 3000));
       el.setAttribute('avatar', '/examples/avatars/arkit-face.glb');
     });
     document.body.append(el);
   }));
   expect(framesAfter, 'frames played after the avatar came').toBe(0);
+});
+
+test('an avatar set at once after the element is added does not keep src from being autoplayed', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/examples/embed.html');
+  const ended = await page.evaluate(() => new Promise<boolean>((resolve, reject) => {
+    document.querySelectorAll('talking-face').forEach((e) => e.remove());
+    const el = document.createElement('talking-face');
+    for (const [k, v] of [['backend', 'cpu'], ['src', '/examples/sample.wav'], ['autoplay', '']]) el.setAttribute(k, v);
+    el.addEventListener('ended', () => resolve(true));
+    el.addEventListener('error', (e) => reject(new Error((e as CustomEvent).detail.message)));
+    document.body.append(el);
+    el.setAttribute('avatar', '/examples/avatars/arkit-face.glb'); // as a framework binding it after mounting does
+    setTimeout(() => resolve(false), 60_000);
+  }));
+  expect(ended, 'the clip was spoken').toBe(true);
 });

@@ -55,14 +55,14 @@ test('a microphone unplugged mid-session stops listening with an error and ended
   await start(page);
   await expect.poll(() => status(page), { timeout: 20_000 }).toContain('Listening');
   // The browser (or the page) suspends the audio: it is resumed, and listening goes on.
-  await page.evaluate(() => (document.getElementById('left') as unknown as { live: { capture: { context: AudioContext } } }).live.capture.context.suspend());
-  await expect.poll(() => page.evaluate(() => (document.getElementById('left') as unknown as { live: { capture: { context: AudioContext } } }).live.capture.context.state), { timeout: 5_000 }).toBe('running');
+  await page.evaluate(() => (document.getElementById('left') as unknown as { liveSession: { capture: { context: AudioContext } } }).liveSession.capture.context.suspend());
+  await expect.poll(() => page.evaluate(() => (document.getElementById('left') as unknown as { liveSession: { capture: { context: AudioContext } } }).liveSession.capture.context.state), { timeout: 5_000 }).toBe('running');
   expect(await events(page)).toEqual([]);
   // The track ends: stopped by a script, which fires no 'ended' event (unplugged, the browser would fire one).
   await page.evaluate(() => (globalThis as unknown as { streams: MediaStream[] }).streams[0].getAudioTracks()[0].stop());
   await expect.poll(() => events(page), { timeout: 5_000 }).toEqual(['error:microphone', 'ended']);
   expect(await status(page)).toMatch(/listening stopped: the microphone stopped sending sound/);
-  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { live: unknown }).live), 'the session is gone').toBeNull();
+  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { liveSession: unknown }).liveSession), 'the session is gone').toBeNull();
 });
 
 test('a restart keeps saying Listening; stop() while permission is asked is no failure', async ({ page }) => {
@@ -76,7 +76,7 @@ test('a restart keeps saying Listening; stop() while permission is asked is no f
   });
   await page.waitForTimeout(3000); // the old session's stop has long resolved
   expect(await status(page)).toContain('Listening');
-  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { live: { keepAudio: boolean } }).live.keepAudio), 'a long session keeps no audio').toBe(false);
+  expect(await page.evaluate(() => (document.getElementById('left') as unknown as { liveSession: { keepAudio: boolean } }).liveSession.keepAudio), 'a long session keeps no audio').toBe(false);
 
   await page.evaluate(() => (document.getElementById('left') as unknown as { stop(): void }).stop());
   await page.evaluate(() => Object.assign(globalThis, { micDelayMs: 1500, micDenied: true, events: [] }));
