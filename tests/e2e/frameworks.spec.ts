@@ -16,35 +16,32 @@ const start = JSX.indexOf('export interface TalkingFaceAttributes');
 const block = JSX.slice(start, JSX.indexOf('\n}\n', start));
 const ATTRIBUTES = [...block.matchAll(/^\s+'?([a-z-]+)'?\?:\s*([^;]+);/gm)].map(([, name, type]) => ({ name, boolean: type.trim() === 'boolean' }));
 
+/** A value of each kind to set: both booleans, else one the attribute takes. */
+const SAMPLE: Record<string, string | number> = { backend: 'cpu', 'avatar-facing': '-z', 'head-motion': 1.5 };
+const CASES = ATTRIBUTES.flatMap(({ name, boolean }) => (boolean ? [true, false] : [SAMPLE[name] ?? '/x']).map((value) => ({ name, value })));
+const label = (name: string, value: unknown, react: number, attribute: string) => `${name}=${JSON.stringify(value)} (React ${react}): ${attribute}`;
+
 test('every declared attribute, set as React 19 and React 18 set props, reaches the element as an attribute', async ({ page }) => {
   expect(ATTRIBUTES.map((a) => a.name)).toEqual(expect.arrayContaining(['src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-facing', 'blendshapes', 'head-motion']));
   await page.goto('/examples/embed.html');
-  const results = await page.evaluate((attributes) => attributes.map(({ name, boolean }) => {
-    const values: unknown[] = boolean ? [true, false] : [name === 'backend' ? 'cpu' : name === 'avatar-facing' ? '-z' : name === 'head-motion' ? 1.5 : '/x'];
-    const out: string[] = [];
-    for (const value of values) {
-      for (const react of [19, 18]) {
-        const el = document.createElement('talking-face') as unknown as HTMLElement & Record<string, unknown>;
-        try {
-          if (react === 19 && name in el) el[name] = value;
-          else if (react === 19 && value === true) el.setAttribute(name, '');
-          else if (react === 19 && value === false) el.removeAttribute(name);
-          else el.setAttribute(name, String(value));
-          out.push(`${name}=${JSON.stringify(value)} (React ${react}): ${JSON.stringify(el.getAttribute(name))}`);
-        } catch (e) {
-          out.push(`${name}=${JSON.stringify(value)} (React ${react}): threw ${(e as Error).message}`);
-        }
-      }
+  const results = await page.evaluate((cases) => cases.flatMap(({ name, value }) => [19, 18].map((react) => {
+    const el = document.createElement('talking-face') as unknown as HTMLElement & Record<string, unknown>;
+    try {
+      if (react === 19 && name in el) el[name] = value;
+      else if (react === 19 && value === true) el.setAttribute(name, '');
+      else if (react === 19 && value === false) el.removeAttribute(name);
+      else el.setAttribute(name, String(value));
+      return JSON.stringify(el.getAttribute(name));
+    } catch (e) {
+      return `threw ${(e as Error).message}`;
     }
-    return out;
-  }), ATTRIBUTES);
-  const expected = ATTRIBUTES.map(({ name, boolean }) => {
-    const value = boolean ? null : name === 'backend' ? 'cpu' : name === 'avatar-facing' ? '-z' : name === 'head-motion' ? '1.5' : '/x';
-    return boolean
-      ? [`${name}=true (React 19): ""`, `${name}=true (React 18): "true"`, `${name}=false (React 19): null`, `${name}=false (React 18): "false"`]
-      : [`${name}=${name === 'head-motion' ? '1.5' : JSON.stringify(value)} (React 19): ${JSON.stringify(value)}`, `${name}=${name === 'head-motion' ? '1.5' : JSON.stringify(value)} (React 18): ${JSON.stringify(value)}`];
-  });
-  expect(results).toEqual(expected);
+  })), CASES);
+  // React 19: true "", false removed, else the value; React 18: every value as a string.
+  const expected = CASES.flatMap(({ name, value }) => [
+    label(name, value, 19, JSON.stringify(value === true ? '' : value === false ? null : String(value))),
+    label(name, value, 18, JSON.stringify(String(value))),
+  ]);
+  expect(CASES.flatMap(({ name, value }, i) => [19, 18].map((react, k) => label(name, value, react, results[2 * i + k])))).toEqual(expected);
 });
 
 test('autoplay="false" does not play and hide-status="false" shows the status, as React 18 writes them', async ({ page }) => {
