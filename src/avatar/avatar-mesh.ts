@@ -63,9 +63,12 @@ export function visemeAsArkit(viseme: VisemeName): Float32Array {
   return w;
 }
 
+/** A morph target of another naming scheme, made as a mix of the ARKit shapes (52 weights). */
+export type MorphAsArkit = readonly [name: string, arkit: Float32Array];
+
 export interface AvatarMeshOptions {
-  /** Which morph targets the mesh has. */
-  morphs: 'arkit' | 'visemes';
+  /** Which morph targets the mesh has: ARKit's 52, the 15 visemes, or the ones listed. */
+  morphs: 'arkit' | 'visemes' | readonly MorphAsArkit[];
   /** The mesh's name (animation tracks refer to it). */
   name?: string;
 }
@@ -79,12 +82,14 @@ export function avatarScene(template: FaceTemplate, basis: ArkitBasis, options: 
   geometry.setIndex(new THREE.BufferAttribute(template.triangles, 1));
   const shape = (k: number) => basis.shapes.subarray(k * n3, (k + 1) * n3);
   const targets: THREE.BufferAttribute[] = [];
-  const names: string[] = options.morphs === 'arkit' ? [...ARKIT_NAMES] : [...VISEME_NAMES];
-  for (const name of names) {
+  const morphs: readonly MorphAsArkit[] = options.morphs === 'arkit' ? [] : options.morphs === 'visemes'
+    ? VISEME_NAMES.map((name) => [name, visemeAsArkit(name)] as const) : options.morphs;
+  const names: string[] = options.morphs === 'arkit' ? [...ARKIT_NAMES] : morphs.map(([name]) => name);
+  for (const [j, name] of names.entries()) {
     const d = new Float32Array(n3);
     if (options.morphs === 'arkit') d.set(shape(ARKIT_INDEX[name as ArkitName]));
     else {
-      const w = visemeAsArkit(name as VisemeName);
+      const w = morphs[j][1];
       for (let k = 0; k < w.length; k++) if (w[k]) for (let i = 0; i < n3; i++) d[i] += w[k] * shape(k)[i];
     }
     for (let i = 0; i < n3; i++) d[i] *= toMetres;

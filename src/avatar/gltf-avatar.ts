@@ -1,30 +1,44 @@
 /**
  * A user's glTF avatar bound to this project's output: its morph targets found by ARKit name or by Oculus viseme
- * name (names.ts: case-insensitive, exporter prefixes stripped, `_L` / `_R` spelled out), and a head bone to turn
- * with the predicted head pose. No renderer here (avatar-view.ts draws it), so it loads in Node too.
+ * name (names.ts: case-insensitive, exporter prefixes stripped, `_L` / `_R` spelled out), or, for a VRM, its five
+ * vowel expressions and its blinks (vrm.ts); and a head bone to turn with the predicted head pose. No renderer here
+ * (avatar-view.ts draws it), so it loads in Node too.
  */
 import * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
+import { VRM_VOWELS, readVrm, threeVrmOf, vowelsOf, type ThreeVrmLike, type VrmFile } from './vrm';
 
 export class AvatarLoadError extends Error {
   override name = 'AvatarLoadError';
 }
 
-/** One morph target driven by one output channel. */
+/** One morph target driven by one output channel: influences[at] gets the channel's value x weight (summed where several drive it). */
 interface Target {
   influences: number[];
   at: number;
   channel: number;
+  weight: number;
 }
+
+/** A VRM's expressions as three-vrm's manager drives them (the page's VRMLoaderPlugin): the vowels and blinks it has. */
+interface ThreeVrmFace {
+  manager: NonNullable<ThreeVrmLike['expressionManager']>;
+  vowels: boolean[];
+  /** Its blink expressions, by blink channel (0 left, 1 right, 2 both). */
+  blinks: [name: string, channel: number][];
+}
+
+export type AvatarScheme = 'arkit' | 'visemes' | 'vrm';
 
 export interface AvatarSummary {
   /**
-   * Which output drives the face: ARKit weights when the avatar has ARKit mouth or jaw targets (or no visemes), else
-   * the visemes (with eyeBlinkLeft / eyeBlinkRight, if it has them, still driven as blinks).
+   * Which output drives the face: ARKit weights when the avatar has ARKit mouth or jaw targets, else the visemes
+   * when it has viseme targets (with eyeBlinkLeft / eyeBlinkRight, if it has them, still driven as blinks), else,
+   * for a VRM, its vowel expressions (aa ih ou ee oh, made from the visemes: vrm.ts) and its blink expressions.
    */
-  scheme: 'arkit' | 'visemes';
-  /** ARKit (or viseme) names the avatar has, out of 52 (15). */
+  scheme: AvatarScheme;
+  /** ARKit (or viseme, or VRM expression) names the avatar has, out of 52 (15, 8). */
   matched: string[];
   /** The bone turned with the head pose, or null. */
   headBone: string | null;
@@ -32,7 +46,10 @@ export interface AvatarSummary {
 
 /** How a glTF avatar is bound: which way its face looks (glTF's convention, +z, unless said otherwise). */
 export interface AvatarBindOptions {
-  /** '+z' (glTF's convention, default) or '-z' (VRM 0.x models, and others made facing away from a glTF camera). */
+  /**
+   * '+z' (glTF's convention) or '-z' (VRM 0.x models, and others made facing away from a glTF camera). Default: '-z'
+   * for a VRM 0.x file, else '+z'.
+   */
   facing?: '+z' | '-z';
 }
 
@@ -47,16 +64,20 @@ export class GltfAvatar {
   /** The model's own eyeBlinkLeft / eyeBlinkRight of the frame shown, and the idle blink on top of them. */
   private readonly modelBlink = [0, 0];
   private idleBlink = 0;
+  /** A VRM's vowels this frame (scheme 'vrm'). */
+  private readonly vowels = new Float32Array(VRM_VOWELS.length);
 
   private constructor(
     readonly gltf: GLTF,
-    readonly scheme: 'arkit' | 'visemes',
+    readonly scheme: AvatarScheme,
     private readonly targets: Target[],
     readonly matched: string[],
     readonly head: THREE.Object3D | null,
     /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
     private readonly blinkTargets: Target[],
     readonly facing: '+z' | '-z',
+    /** A VRM loaded with three-vrm: its expressions are set through its manager, which vrm.update() applies. */
+    private readonly threeVrm: ThreeVrmFace | null = null,
   ) {
     if (head) this.rest.copy(head.quaternion);
   }
@@ -96,7 +117,9 @@ export class GltfAvatar {
       throw new TypeError(`GltfAvatar.bind(${source}): give what GLTFLoader gave (gltf), not its scene: GltfAvatar.bind(gltf, ...)`);
     }
     if (!gltf?.scene) throw new AvatarLoadError(`${source} has no scene: export the avatar with its scene`);
-    const facing = options.facing ?? '+z';
+    const threeVrm = threeVrmOf(gltf);
+    const vrm = threeVrm ? null : readVrm(gltf);
+    const facing = options.facing ?? ((threeVrm?.meta?.metaVersion ?? vrm?.version) === '0' ? '-z' : '+z');
     if (facing !== '+z' && facing !== '-z') throw new TypeError(`GltfAvatar.bind(${source}): facing is '+z' or '-z', not ${JSON.stringify(facing)}`);
     const arkit: Target[] = [];
     const visemes: Target[] = [];
@@ -107,41 +130,69 @@ export class GltfAvatar {
       for (const [name, at] of Object.entries(mesh.morphTargetDictionary)) {
         names.add(name);
         const a = arkitIndexOf(name), v = visemeIndexOf(name);
-        if (a >= 0) arkit.push({ influences: mesh.morphTargetInfluences, at, channel: a });
-        if (v >= 0) visemes.push({ influences: mesh.morphTargetInfluences, at, channel: v });
+        if (a >= 0) arkit.push({ influences: mesh.morphTargetInfluences, at, channel: a, weight: 1 });
+        if (v >= 0) visemes.push({ influences: mesh.morphTargetInfluences, at, channel: v, weight: 1 });
       }
     });
-    if (!arkit.length && !visemes.length) {
+    // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
+    const arkitMouth = arkit.some((t) => /^(jaw|mouth)/.test(ARKIT_NAMES[t.channel]));
+    const has = (name: string) => (threeVrm ? threeVrm.expressionManager!.getExpression(name) != null : !!vrm?.expressions.get(name)?.length);
+    const vrmMouth = VRM_VOWELS.some(has);
+    if (!arkit.length && !visemes.length && !vrmMouth) {
       const found = names.size
         ? `its morph targets are: ${[...names].slice(0, 60).join(', ')}${names.size > 60 ? ', …' : ''}. Rename them`
         : 'it has no morph targets at all: export it with its blend shapes (shape keys), named so';
       throw new AvatarLoadError(`${source} has no morph targets named after ARKit's 52 blend shapes (jawOpen, eyeBlinkLeft, …) ` +
-        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …); ${found} (docs/embedding.md, "Avatars").`);
+        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …)${threeVrm || vrm ? ', and its VRM expressions have no vowels (aa, ih, ou, ee, oh)' : ''}; ` +
+        `${found} (docs/embedding.md, "Avatars").`);
     }
-    // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
-    const arkitMouth = arkit.some((t) => /^(jaw|mouth)/.test(ARKIT_NAMES[t.channel]));
-    const scheme = arkitMouth || !visemes.length ? 'arkit' : 'visemes';
-    const targets = scheme === 'arkit' ? arkit : visemes;
-    const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
-    const matched = [...new Set(targets.map((t) => all[t.channel]))];
-    const blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
+    const scheme = arkitMouth || (!visemes.length && !vrmMouth) ? 'arkit' : visemes.length ? 'visemes' : 'vrm';
+    const head = headBone || !(threeVrm || vrm)
+      ? findHead(gltf.scene, source, headBone)
+      : threeVrm?.humanoid?.getNormalizedBoneNode('head') ?? vrm?.head ?? findHead(gltf.scene, source, null);
+    // Blinks: eyeBlinkLeft / Right (channels 0, 1), else a VRM's blinkLeft / Right, else its blink (2: both eyes).
+    const blinkNames = has('blinkLeft') && has('blinkRight') ? ['blinkLeft', 'blinkRight'] : has('blink') ? ['blink'] : [];
+    const vrmBlinkChannel = (name: string) => ['blinkLeft', 'blinkRight', 'blink'].indexOf(name);
+    let blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
       .map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
-    return new GltfAvatar(gltf, scheme, targets, matched, findHead(gltf.scene, source, headBone), blinks, facing);
+    if (!blinks.length && vrm) blinks = blinkNames.flatMap((name) => vrm.expressions.get(name)!.map((b) => ({ ...b, channel: vrmBlinkChannel(name) })));
+    if (scheme !== 'vrm') {
+      const targets = scheme === 'arkit' ? arkit : visemes;
+      const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
+      const matched = [...new Set(targets.map((t) => all[t.channel]))];
+      return new GltfAvatar(gltf, scheme, targets, matched, head, blinks, facing);
+    }
+    const vowels = VRM_VOWELS.map(has);
+    const matched = [...VRM_VOWELS.filter((_, k) => vowels[k]), ...blinkNames];
+    if (threeVrm) {
+      const face = { manager: threeVrm.expressionManager!, vowels, blinks: blinkNames.map((n) => [n, vrmBlinkChannel(n)] as [string, number]) };
+      return new GltfAvatar(gltf, scheme, [], matched, head, [], facing, face);
+    }
+    const targets = VRM_VOWELS.flatMap((name, channel) => (vrm as VrmFile).expressions.get(name)?.map((b) => ({ ...b, channel })) ?? []);
+    return new GltfAvatar(gltf, scheme, targets, matched, head, blinks, facing);
   }
 
   get summary(): AvatarSummary {
     return { scheme: this.scheme, matched: this.matched, headBone: this.head?.name ?? null };
   }
 
-  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets). */
+  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets, or a VRM's blink expressions). */
   get canBlink(): boolean {
-    return this.blinkTargets.length > 0;
+    return this.blinkTargets.length > 0 || !!this.threeVrm?.blinks.length;
   }
 
-  /** Set the morph targets from one frame of output: ARKit weights (52) and visemes (15), each from its index `at`. */
+  /**
+   * Set the morph targets from one frame of output: ARKit weights (52) and visemes (15), each from its index `at`
+   * (a VRM's vowels are made from the visemes). With three-vrm, its expressions are set, which vrm.update() applies.
+   */
   setWeights(arkit: ArrayLike<number>, arkitAt: number, visemes: ArrayLike<number>, visemesAt: number): void {
-    const [values, at] = this.scheme === 'arkit' ? [arkit, arkitAt] : [visemes, visemesAt];
-    for (const t of this.targets) t.influences[t.at] = values[at + t.channel];
+    let values: ArrayLike<number> = this.scheme === 'arkit' ? arkit : visemes;
+    let at = this.scheme === 'arkit' ? arkitAt : visemesAt;
+    if (this.scheme === 'vrm') {
+      values = vowelsOf(visemes, visemesAt, this.vowels);
+      at = 0;
+    }
+    this.writeTargets(values, at);
     this.modelBlink[0] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkLeft];
     this.modelBlink[1] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkRight];
     this.applyBlink();
@@ -158,7 +209,7 @@ export class GltfAvatar {
    * the animation's rotation they turned (the page's, where it has set the bone since).
    */
   reset(): void {
-    for (const t of this.targets) t.influences[t.at] = 0;
+    this.writeTargets(ZEROS, 0);
     this.modelBlink.fill(0);
     this.applyBlink();
     const q = this.head?.quaternion; // (not turned since binding or the last reset: left as the page has it)
@@ -167,8 +218,23 @@ export class GltfAvatar {
     this.wroteOnTop = null;
   }
 
+  /** Each target to its channel's value x its weight (0 first: a VRM's expressions may share a morph target, and add). */
+  private writeTargets(values: ArrayLike<number>, at: number): void {
+    for (const t of this.targets) t.influences[t.at] = 0;
+    for (const t of this.targets) t.influences[t.at] += values[at + t.channel] * t.weight;
+    const face = this.threeVrm;
+    if (face) for (let k = 0; k < VRM_VOWELS.length; k++) if (face.vowels[k]) face.manager.setValue(VRM_VOWELS[k], values[at + k]);
+  }
+
+  /** A blink channel's closure: 0 left, 1 right, 2 both (a VRM's one blink expression), with the idle blink on top. */
+  private blinkOf(channel: number): number {
+    const model = channel === 2 ? Math.max(this.modelBlink[0], this.modelBlink[1]) : this.modelBlink[channel];
+    return Math.max(model, this.idleBlink);
+  }
+
   private applyBlink(): void {
-    for (const t of this.blinkTargets) t.influences[t.at] = Math.max(this.modelBlink[t.channel], this.idleBlink);
+    for (const t of this.blinkTargets) t.influences[t.at] = this.blinkOf(t.channel) * t.weight;
+    if (this.threeVrm) for (const [name, channel] of this.threeVrm.blinks) this.threeVrm.manager.setValue(name, this.blinkOf(channel));
   }
 
   /**
@@ -226,6 +292,7 @@ function folderOf(source: string): string {
   }
 }
 
+const ZEROS = new Float32Array(ARKIT_NAMES.length);
 const scratch = new THREE.Quaternion();
 const inverse = new THREE.Quaternion();
 const sceneWorld = new THREE.Quaternion();

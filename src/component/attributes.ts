@@ -15,13 +15,14 @@ export function backendAttribute(value: string | null): 'auto' | Backend {
 }
 
 /**
- * How the `avatar` is bound: `avatar-head-bone` (the node turned with the head; default Head or head) and
- * `avatar-facing` (+z, glTF's convention and the default, or -z: VRM 0.x; another value warns and means +z).
+ * How the `avatar` is bound: `avatar-head-bone` (the node turned with the head; default Head or head, or a VRM's
+ * humanoid head) and `avatar-facing` (+z, glTF's convention, or -z; absent, the file decides: -z for VRM 0.x, else
+ * +z; another value warns and is left to the file likewise).
  */
-export function avatarAttributes(el: Element): { headBone: string | null; facing: '+z' | '-z' } {
+export function avatarAttributes(el: Element): { headBone: string | null; facing: '+z' | '-z' | undefined } {
   const v = el.getAttribute('avatar-facing')?.trim() ?? '';
-  if (v && v !== '+z' && v !== '-z') console.warn(`<talking-face> avatar-facing="${v}" is not +z or -z; using +z (glTF's convention)`);
-  return { headBone: el.getAttribute('avatar-head-bone'), facing: v === '-z' ? '-z' : '+z' };
+  if (v && v !== '+z' && v !== '-z') console.warn(`<talking-face> avatar-facing="${v}" is not +z or -z; ignored (the file decides: -z for VRM 0.x, else +z)`);
+  return { headBone: el.getAttribute('avatar-head-bone'), facing: v === '-z' || v === '+z' ? v : undefined };
 }
 
 /**

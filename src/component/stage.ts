@@ -28,7 +28,7 @@ export class ElementStage {
    * shown, false if superseded meanwhile (drop(), another make(), the element removed); rejects with a message for
    * a person (kept in `error`).
    */
-  async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, bound: { headBone: string | null; facing: '+z' | '-z' }): Promise<boolean> {
+  async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, bound: { headBone: string | null; facing: '+z' | '-z' | undefined }): Promise<boolean> {
     const token = (this.token = {});
     const root = this.canvas.getRootNode() as ShadowRoot; // the element's
     const canvas = newCanvas(root.host);

@@ -24,13 +24,14 @@ describe('<talking-face> attributes', () => {
     expect(frameOptions(el({ blendshapes: '' })).blendshapes).toBe(true);
   });
 
-  it('avatar-facing: +z (default) or -z; anything else warns and means +z', () => {
+  it('avatar-facing: +z or -z; absent, left to the file (VRM 0.x: -z); anything else warns and is left to the file', () => {
     const warn = vi.spyOn(console, 'warn').mockImplementation(() => undefined);
     const el = (attrs: Record<string, string>) => ({ getAttribute: (n: string) => attrs[n] ?? null }) as unknown as Element;
-    expect(avatarAttributes(el({}))).toEqual({ headBone: null, facing: '+z' });
+    expect(avatarAttributes(el({}))).toEqual({ headBone: null, facing: undefined });
     expect(avatarAttributes(el({ 'avatar-facing': '-z', 'avatar-head-bone': 'Skull' }))).toEqual({ headBone: 'Skull', facing: '-z' });
+    expect(avatarAttributes(el({ 'avatar-facing': ' +z ' })).facing).toBe('+z');
     expect(warn).not.toHaveBeenCalled();
-    expect(avatarAttributes(el({ 'avatar-facing': 'back' })).facing).toBe('+z');
+    expect(avatarAttributes(el({ 'avatar-facing': 'back' })).facing).toBe(undefined);
     expect(warn).toHaveBeenCalledWith(expect.stringContaining('avatar-facing="back" is not +z or -z'));
     warn.mockRestore();
   });
