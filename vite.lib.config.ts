@@ -2,7 +2,7 @@ import { defineConfig, defaultClientConditions } from 'vite';
 import { cpSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { precompress } from './scripts/hosting.ts';
-import { vendorProjectThree, vendorTalkingHead } from './scripts/talkinghead-vendor.ts';
+import { vendorProjectThree, vendorTalkingHead, vendorThreeVrm } from './scripts/talkinghead-vendor.ts';
 import { captureWorkletFile } from './scripts/worklet-file.ts';
 
 /**
@@ -11,7 +11,8 @@ import { captureWorkletFile } from './scripts/worklet-file.ts';
  * dist/ort/ it uses: deploy lib/, models/ and ort/ side by side (docs/embedding.md). The example pages
  * (examples/) are copied to dist/examples/, with TalkingHead and its three.js in dist/examples/vendor/ for
  * examples/talkinghead.html, and the project's own three.js in dist/examples/vendor/three-project/ for
- * examples/own-scene.html (scripts/talkinghead-vendor.ts).
+ * examples/own-scene.html, with @pixiv/three-vrm in dist/examples/vendor/three-vrm/ for its .vrm avatars
+ * (scripts/talkinghead-vendor.ts).
  *
  * `--mode npm` builds the same entry for bundlers into dist/lib/npm/ (the package's import): three.js is left to the
  * project that installs it (a peer dependency), so a page with its own three.js scene has one copy of it, not two.
@@ -45,6 +46,7 @@ const standalone = defineConfig({
         cpSync(resolve(import.meta.dirname, 'examples'), resolve(import.meta.dirname, 'dist/examples'), { recursive: true });
         vendorTalkingHead(resolve(import.meta.dirname, 'dist/examples/vendor'));
         vendorProjectThree(resolve(import.meta.dirname, 'dist/examples/vendor'), import.meta.dirname);
+        vendorThreeVrm(resolve(import.meta.dirname, 'dist/examples/vendor'), import.meta.dirname);
         for (const dir of ['dist/lib', 'dist/examples']) precompress(resolve(import.meta.dirname, dir));
       },
     },

@@ -10,7 +10,8 @@
  *   vendor/three/build/three.module.js, three.core.js, LICENSE
  *   vendor/three/examples/jsm/loaders/GLTFLoader.js, ... (the addons' own layout: they import each other relatively)
  *
- * The project's own three.js goes beside it (vendorProjectThree), for examples/own-scene.html: vendor/three-project/.
+ * The project's own three.js goes beside it (vendorProjectThree), for examples/own-scene.html: vendor/three-project/;
+ * and @pixiv/three-vrm (vendorThreeVrm, a devDependency), which that page loads for a .vrm avatar: vendor/three-vrm/.
  */
 import { cpSync, existsSync, mkdirSync, readFileSync, readdirSync } from 'node:fs';
 import { createRequire } from 'node:module';
@@ -98,4 +99,21 @@ function copyInto(vendorDir: string, from: string, to: string): string {
   mkdirSync(dirname(to), { recursive: true });
   cpSync(from, to, { preserveTimestamps: true });
   return relative(vendorDir, to);
+}
+
+/**
+ * @pixiv/three-vrm's module build (one file; it imports only `three`, the page's) and its licence (MIT) into
+ * `vendorDir`/three-vrm/: examples/own-scene.html loads it for a .vrm avatar through its import map.
+ */
+export function vendorThreeVrm(vendorDir: string, root: string): string[] {
+  let manifest: string;
+  try {
+    manifest = createRequire(join(root, 'package.json')).resolve('@pixiv/three-vrm/package.json');
+  } catch (e) {
+    throw new Error(`examples/own-scene.html needs @pixiv/three-vrm (a devDependency) for .vrm avatars: run npm install (${(e as Error).message})`);
+  }
+  const from = dirname(manifest), module = join(from, 'lib/three-vrm.module.min.js');
+  const foreign = importsOf(module).concat([...readFileSync(module, 'utf8').matchAll(/from"([^"]+)"/g)].map((m) => m[1])).filter((s) => s !== 'three');
+  if (foreign.length) throw new Error(`${module} imports ${foreign.join(', ')}: the import map has no entry for it`);
+  return [module, join(from, 'LICENSE')].map((f) => copyInto(vendorDir, f, join(vendorDir, 'three-vrm', f === module ? 'three-vrm.module.js' : 'LICENSE')));
 }

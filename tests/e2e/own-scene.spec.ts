@@ -10,7 +10,9 @@ import { ARKIT_NAMES } from '../../src/avatar/names';
  * the audio clock, and live from a (fake) microphone. Read from the avatar itself at many instants: its morph
  * targets are the take's weights for the frame shown and its head bone, relative to the avatar's root, is the
  * predicted rotation on top of its rest, although the page turned the avatar. One three.js, from the page's origin,
- * and no element defined; no console error (fixtures.ts).
+ * and no element defined; no console error (fixtures.ts). A VRM 0.x avatar (?avatar=...vrm) is loaded with
+ * @pixiv/three-vrm, driven through its expressions and normalized head, which vrm.update() applies to the model: its
+ * morph targets open on speech and its own head bone turns as the take says, in the avatar's own axes (facing -z).
  */
 test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
@@ -26,14 +28,17 @@ interface Sample {
 
 type Page = import('@playwright/test').Page;
 
-/** Read the avatar every ~70 ms until collect() is called again with `stop`. */
-async function sample(page: Page, names: readonly string[]) {
-  await page.evaluate((names) => {
+/**
+ * Read the avatar every ~70 ms until collect() is called: the morph targets `names` and the head's turn (of the
+ * driver's head bone, or of the node named `headName`: a three-vrm model's own head, which vrm.update() turns).
+ */
+async function sample(page: Page, names: readonly string[], headName: string | null = null) {
+  await page.evaluate(([names, headName]) => {
     const g = globalThis as any;
     const { state, THREE } = g.ownSceneExample;
-    const avatar = state.driver.avatar, head = avatar.head, root = avatar.gltf.scene;
+    const avatar = state.driver.avatar, root = avatar.gltf.scene, head = headName ? root.getObjectByName(headName) : avatar.head;
     let mesh: any;
-    root.traverse((o: any) => { if (o.morphTargetInfluences) mesh = o; });
+    root.traverse((o: any) => { if (o.morphTargetDictionary?.[names[0]] !== undefined) mesh = o; });
     const restInverse = head.quaternion.clone().invert(); // sampled at rest: the head bone's own rest rotation
     const parentInRoot = () => root.getWorldQuaternion(new THREE.Quaternion()).invert().multiply(head.parent.getWorldQuaternion(new THREE.Quaternion()));
     g.samples = [];
@@ -48,7 +53,7 @@ async function sample(page: Page, names: readonly string[]) {
         turn: [d.x, d.y, d.z, d.w],
       });
     }, 70);
-  }, [...names]);
+  }, [[...names], headName] as const);
 }
 const collect = (page: Page): Promise<Sample[]> => page.evaluate(() => {
   const g = globalThis as any;
@@ -109,5 +114,41 @@ test('an avatar in the page\'s own three.js scene speaks a take frame by frame, 
   expect(Math.max(...live.map((s) => s.speech)), 'blended in').toBe(1);
   await page.locator('#stop').click();
   await expect(page.locator('#log')).toHaveText('stopped listening');
+  await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
+});
+
+test('a VRM 0.x avatar loaded with @pixiv/three-vrm in the page\'s own scene speaks through its expressions and turns its head', async ({ page, guard }) => {
+  test.setTimeout(180_000);
+  await page.goto('/examples/own-scene.html?avatar=/examples/avatars/vrm0-face.vrm');
+  await expect(page.locator('#log')).toHaveText(/^ready: \d+ frames of the sample/, { timeout: 150_000 });
+  expect(guard.requests.map((u) => new URL(u).pathname)).toContain('/examples/vendor/three-vrm/three-vrm.module.js');
+  const bound = await page.evaluate(() => {
+    const { state } = (globalThis as any).ownSceneExample;
+    return { metaVersion: state.vrm?.meta?.metaVersion, summary: state.driver.avatar.summary, facing: state.driver.avatar.facing };
+  });
+  expect(bound).toEqual({ metaVersion: '0', summary: { scheme: 'vrm', matched: ['aa', 'ih', 'ou', 'ee', 'oh', 'blinkLeft', 'blinkRight'], headBone: 'Normalized_Head' }, facing: '-z' });
+  const take = await page.evaluate(() => {
+    const { take } = (globalThis as any).ownSceneExample.state;
+    return { frames: take.frames as number, pose: Array.from(take.pose as Float32Array) };
+  });
+
+  await sample(page, ['Fcl_MTH_A', 'Fcl_MTH_I', 'Fcl_MTH_U', 'Fcl_MTH_E', 'Fcl_MTH_O'], 'Head');
+  await page.locator('#speak').click();
+  await expect(page.locator('#log')).toHaveText(`played ${take.frames} frames`, { timeout: 30_000 });
+  const played = (await collect(page)).filter((s) => s.frame >= 0 && s.speech === 1);
+  expect(new Set(played.map((s) => s.frame)).size, 'distinct frames sampled at full weight').toBeGreaterThanOrEqual(8);
+  const opening = played.map((s) => s.influences.reduce((a, x) => a + x, 0));
+  expect(Math.max(...opening) - Math.min(...opening), 'the mouth opens and closes').toBeGreaterThan(0.3);
+  let nodded = 0;
+  for (const s of played) {
+    // The turn in gltf.scene's axes: the avatar faces -z there, so its own x and z are the scene's -x and -z.
+    const [rx, ry, rz] = take.pose.slice(s.frame * 6, s.frame * 6 + 3);
+    const angle = Math.hypot(rx, ry, rz), sin = Math.sin(angle / 2) / (angle || 1);
+    const want = [-rx * sin, ry * sin, -rz * sin, Math.cos(angle / 2)];
+    const dot = Math.abs(want.reduce((a, w, i) => a + w * s.turn[i], 0));
+    expect(2 * Math.acos(Math.min(1, dot)), `the model's head's turn at frame ${s.frame}`).toBeLessThan(1e-4);
+    nodded = Math.max(nodded, angle);
+  }
+  expect(nodded, 'the head turns').toBeGreaterThan(0.01);
   await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
 });
