@@ -69,11 +69,12 @@ const forBundlers = defineConfig({
     // Two entries: the element and the library (talking-face.js), and the library alone (engine.js: `talking-face/engine`,
     // which defines no element and does not bring the face's renderer); what they share goes in a chunk of its own.
     lib: {
-      // jsx.js: talking-face/jsx holds only declarations; a module with nothing in it, for an `import` that is not `import type`.
+      // jsx.js, vue.js, svelte.js: talking-face/jsx, /vue and /svelte hold only declarations; modules with nothing in
+      // them, for an `import` that is not `import type`.
       entry: {
         'talking-face': resolve(import.meta.dirname, 'src/component/index.ts'),
         engine: resolve(import.meta.dirname, 'src/index.ts'),
-        jsx: resolve(import.meta.dirname, 'src/component/jsx.ts'),
+        ...Object.fromEntries(['jsx', 'vue', 'svelte'].map((name) => [name, resolve(import.meta.dirname, `src/component/${name}.ts`)])),
       },
       formats: ['es'],
       fileName: (_format, name) => `${name}.js`,

@@ -5,13 +5,13 @@ import { test, expect } from './fixtures';
 /**
  * <talking-face> as frameworks set its attributes. React 19 sets a prop on a custom element as a property where the
  * element has one (`name in element`), else as an attribute (true: "", false: removed); React 18 writes every prop
- * as an attribute, false as "false". For every attribute talking-face/jsx declares (src/component/jsx.ts), both
+ * as an attribute, false as "false". For every attribute the declarations type (src/component/element-types.ts), both
  * ways: nothing throws (a getter without a setter would, in a module's strict code) and the attribute ends up as the
  * element reads it. Then React 18's "false": an element with autoplay="false" and hide-status="false" does not play
  * and shows its status. And an avatar switched on from state after an autoplayed take does not speak it again, while
  * one set at once after the element is added does not keep it from being autoplayed.
  */
-const JSX = readFileSync(resolve(import.meta.dirname, '../../src/component/jsx.ts'), 'utf8');
+const JSX = readFileSync(resolve(import.meta.dirname, '../../src/component/element-types.ts'), 'utf8');
 const start = JSX.indexOf('export interface TalkingFaceAttributes');
 const block = JSX.slice(start, JSX.indexOf('\n}\n', start));
 const ATTRIBUTES = [...block.matchAll(/^\s+'?([a-z-]+)'?\?:\s*([^;]+);/gm)].map(([, name, type]) => ({ name, boolean: type.trim() === 'boolean' }));

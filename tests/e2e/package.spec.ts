@@ -36,7 +36,7 @@ test('imports where there is no DOM, with three.js its importer\'s', () => {
   expect(code).not.toContain('__THREE__'); // three.js's own code, which the standalone build carries
 });
 
-test('needs nothing installed beside it but its peers: its code and its declarations import only three.js (and React\'s types, for JSX)', () => {
+test('needs nothing installed beside it but its peers: its code and its declarations import only three.js (and React\'s, Vue\'s and Svelte\'s types, opt-in)', () => {
   const pkg = JSON.parse(readFileSync(join(ROOT, 'package.json'), 'utf8')) as { dependencies?: object; peerDependencies: object; exports: Record<string, Record<string, string>> };
   expect(pkg.dependencies ?? {}, 'dependencies (onnxruntime-web is bundled into the code, its runtime into dist/ort)').toEqual({});
   // A peer's specifier, or its types' (@types/react is what 'react' names in the declarations of talking-face/jsx).
@@ -136,6 +136,44 @@ test('talking-face/jsx types the element in React\'s JSX: its attributes, and a 
   expect(run('node', ['--input-type=module', '-e', "console.log(String(Object.keys(await import('talking-face/jsx')).length))"]).trim()).toBe('0');
   // Without the opt-in, React's JSX does not know the element.
   expect(typecheck({ 'use.tsx': use.replace("import type {} from 'talking-face/jsx';", '') }, options)).toMatch(/Property 'talking-face' does not exist on type 'JSX\.IntrinsicElements'/);
+});
+
+test('talking-face/vue and talking-face/svelte type the element\'s attributes and events for Vue and Svelte 5', () => {
+  test.setTimeout(120_000);
+  const options = { target: 'es2022', module: 'esnext', moduleResolution: 'bundler', lib: ['es2022', 'dom', 'dom.iterable'], types: [] };
+  // Vue: what vue-tsc checks a template's <talking-face> against (GlobalComponents; `@frame` is the prop onFrame, and
+  // `:hide-status` the prop hideStatus).
+  const vue = [
+    "import type {} from 'talking-face/vue';",
+    "import type { GlobalComponents } from 'vue';",
+    "type Props = InstanceType<GlobalComponents['talking-face']>['$props'];",
+    "export const ok: Props = { src: null, backend: 'cpu', autoplay: false, avatar: '/me.vrm', headMotion: 1.5, hideStatus: true, avatarFacing: '-z',",
+    "  onFrame: (e) => { const n: number = e.detail.frame; console.log(n); }, onError: (e) => console.log(e.detail.stage), onEnded: () => undefined };",
+    '// @ts-expect-error: not one of its backends',
+    "export const bad: Props = { backend: 'gpu' };",
+    '// @ts-expect-error: the ready detail has no such field',
+    'export const wrong: Props = { onReady: (e) => e.detail.nonexistent };',
+    "// @ts-expect-error: vue-tsc reads a template's head-motion as headMotion",
+    "export const kebab: Props = { 'head-motion': 1 };",
+  ].join('\n');
+  expect(typecheck({ 'use.ts': vue }, options)).toBe('');
+  expect(typecheck({ 'use.ts': vue.replace("import type {} from 'talking-face/vue';", '') }, options)).toMatch(/Property 'talking-face' does not exist on type 'GlobalComponents'/);
+  // Svelte 5: its elements' attributes (`onframe={...}` is an event attribute; `bind:this` gets TalkingFaceElement).
+  const svelte = [
+    "import type {} from 'talking-face/svelte';",
+    "import type { SvelteHTMLElements } from 'svelte/elements';",
+    "type Attributes = SvelteHTMLElements['talking-face'];",
+    "export const ok: Attributes = { src: null, backend: 'cpu', 'hide-status': true, 'avatar-facing': '-z', class: 'face',",
+    "  onframe: (e) => { const n: number = e.detail.frame; console.log(n); }, onerror: (e) => console.log(e.detail.stage) };",
+    '// @ts-expect-error: not one of its backends',
+    "export const bad: Attributes = { backend: 'gpu' };",
+  ].join('\n');
+  expect(typecheck({ 'use.ts': svelte }, options)).toBe('');
+  // Without the opt-in, Svelte takes any attribute on an element it does not know: the expected error is missing.
+  expect(typecheck({ 'use.ts': svelte.replace("import type {} from 'talking-face/svelte';", '') }, options)).toMatch(/Unused '@ts-expect-error' directive/);
+  for (const entry of ['vue', 'svelte']) {
+    expect(run('node', ['--input-type=module', '-e', `console.log(String(Object.keys(await import('talking-face/${entry}')).length))`]).trim(), entry).toBe('0');
+  }
 });
 
 test('its declarations type a project that resolves modules as Node does (node16)', () => {
