@@ -3,7 +3,8 @@
  * morph targets named as VRoid Studio names them (Fcl_MTH_A ...), none of them an ARKit or viseme name, so only the
  * file's VRM extension says which moves the mouth: VRM 1.0's VRMC_vrm (expressions bound by node, weights 0-1, the
  * face towards +z) or VRM 0.x's VRM (blend-shape groups bound by mesh, weights 0-100, the face towards -z). Each
- * vowel is the viseme of that vowel (avatar-mesh.ts's visemeAsArkit); the humanoid maps VRM's bones to the rig's.
+ * vowel is the viseme of that vowel (avatar-mesh.ts's visemeAsArkit); the face is two primitives, as VRoid's is
+ * several; the humanoid maps VRM's bones to the rig's.
  */
 import * as THREE from 'three';
 import type { FaceTemplate } from '../template/face-template';
@@ -49,7 +50,14 @@ interface GlbJson {
 /** A VRM test avatar as .vrm (.glb) bytes: VRM 1.0 (`'1'`) or 0.x (`'0'`). */
 export async function buildVrmAvatarGlb(template: FaceTemplate, version: '0' | '1'): Promise<ArrayBuffer> {
   const morphs: MorphAsArkit[] = MORPHS.map(([name, , arkit]) => [name, arkit]);
-  const { head } = avatarScene(template, arkitBasis(template), { morphs, name: 'Face' });
+  const { head, mesh } = avatarScene(template, arkitBasis(template), { morphs, name: 'Face' });
+  // Two primitives sharing the morph targets, as VRoid's face has several (skin, mouth, eyes...): three.js loads the
+  // node as a group of meshes, each of which an expression's bind moves.
+  const triangles = mesh.geometry.index!.count, half = 3 * Math.floor(triangles / 6);
+  mesh.geometry.addGroup(0, half, 0);
+  mesh.geometry.addGroup(half, triangles - half, 1);
+  const skin = mesh.material as THREE.MeshStandardMaterial;
+  mesh.material = [skin, skin.clone()];
   const scene = fullBodyScene(head);
   if (version === '0') scene.getObjectByName('Armature')!.rotation.y = Math.PI; // VRM 0.x faces -z
   const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
@@ -57,7 +65,7 @@ export async function buildVrmAvatarGlb(template: FaceTemplate, version: '0' | '
   scene.traverse((o) => {
     if (!(o as THREE.Mesh).isMesh) return;
     (o as THREE.Mesh).geometry.dispose();
-    ((o as THREE.Mesh).material as THREE.Material).dispose();
+    [(o as THREE.Mesh).material].flat().forEach((m) => m.dispose());
   });
   return withJson(glb, (json) => addVrm(json, version));
 }

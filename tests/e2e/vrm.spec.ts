@@ -47,10 +47,10 @@ const add = (page: import('@playwright/test').Page, avatar: string, facing: stri
   document.body.prepend(el);
 }), [avatar, facing] as const);
 
-/** The avatar's Face mesh's mouth influences now. */
+/** The avatar's face's mouth influences now (its last primitive's). */
 const mouthNow = (page: import('@playwright/test').Page) => page.evaluate((names) => {
   let face: Mesh | null = null;
-  (document.querySelector('talking-face') as FaceEl).avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).name === 'Face') face = o as Mesh; });
+  (document.querySelector('talking-face') as FaceEl).avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).morphTargetDictionary?.[names[0]] !== undefined) face = o as Mesh; });
   const m = face as unknown as Mesh;
   return names.map((n) => m.morphTargetInfluences![m.morphTargetDictionary![n]]);
 }, MOUTH);
@@ -67,7 +67,7 @@ test('a VRM avatar speaks through its vowel expressions: open on open vowels, cl
     const w = globalThis as unknown as { widest: number };
     w.widest = 0;
     const meshes: Mesh[] = [];
-    (document.querySelector('talking-face') as FaceEl).avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).name === 'Face') meshes.push(o as Mesh); });
+    (document.querySelector('talking-face') as FaceEl).avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).morphTargetDictionary?.[names[0]] !== undefined) meshes.push(o as Mesh); });
     const watch = () => {
       for (const m of meshes) w.widest = Math.max(w.widest, names.reduce((s, n) => s + m.morphTargetInfluences![m.morphTargetDictionary![n]], 0));
       requestAnimationFrame(watch);
@@ -85,8 +85,8 @@ test('a VRM avatar speaks through its vowel expressions: open on open vowels, cl
     const el = document.querySelector('talking-face') as FaceEl;
     const { frames, blendshapes: b } = el.currentAnimation!;
     const meshes: Mesh[] = [];
-    el.avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).name === 'Face') meshes.push(o as Mesh); });
-    const m = meshes[0];
+    el.avatar!.gltf.scene.traverse((o) => { if ((o as Mesh).morphTargetDictionary?.[names[0]] !== undefined) meshes.push(o as Mesh); });
+    const m = meshes[meshes.length - 1]; // (the face's second primitive: each is driven)
     const out: number[] = [];
     for (let f = 0; f < frames; f++) {
       el.avatar!.setWeights(b.arkit, f * 52, b.visemes, f * 15);

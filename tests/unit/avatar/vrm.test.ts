@@ -28,9 +28,13 @@ async function load(name: string, threeVrm: boolean): Promise<GLTF> {
   if (threeVrm) loader.register((parser) => new VRMLoaderPlugin(parser));
   return loader.parseAsync(bytes(name), '');
 }
-/** The Face mesh's influence of each named morph target. */
+/** The face's influence of each named morph target, the same in each of its two primitives (meshes). */
 const morphs = (gltf: GLTF) => {
-  const face = gltf.scene.getObjectByName('Face') as THREE.Mesh;
+  const meshes: THREE.Mesh[] = [];
+  gltf.scene.traverse((o) => { if ((o as THREE.Mesh).morphTargetDictionary?.Fcl_MTH_A !== undefined) meshes.push(o as THREE.Mesh); });
+  const [face, ...others] = meshes;
+  expect(others.length).toBe(1);
+  for (const other of others) expect(other.morphTargetInfluences).toEqual(face.morphTargetInfluences);
   return Object.fromEntries(Object.entries(face.morphTargetDictionary!).map(([n, i]) => [n, face.morphTargetInfluences![i]]));
 };
 const oneHot = (n: number, k: number, v = 1) => Float32Array.from({ length: n }, (_, i) => (i === k ? v : 0));
