@@ -5,14 +5,14 @@
  * examples/avatars/arkit-full-body.glb (the ARKit face on a full-body skeleton with Ready Player Me's bone names,
  * which TalkingHead requires; src/avatar/full-body-rig.ts), and examples/avatars/vrm1-face.vrm and vrm0-face.vrm
  * (VRoid's morph-target names on the full-body rig, driven only through the file's VRM 1.0 or 0.x extension;
- * src/avatar/vrm-avatar.ts). A unit test checks that the committed files are exactly what this writes.
+ * src/avatar/vrm-test-avatar.ts). A unit test checks that the committed files are exactly what this writes.
  */
 import { readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { decodeTemplate } from '../src/template/face-template';
 import { buildAvatarGlb } from '../src/avatar/avatar-mesh';
 import { buildFullBodyAvatarGlb } from '../src/avatar/full-body-rig';
-import { buildVrmAvatarGlb } from '../src/avatar/vrm-avatar';
+import { buildVrmAvatarGlb } from '../src/avatar/vrm-test-avatar';
 import { installFileReader } from '../tests/unit/helpers/file-reader';
 
 const ROOT = resolve(import.meta.dirname, '..');

@@ -1,35 +1,17 @@
 /**
- * A user's glTF avatar bound to this project's output: its morph targets found by ARKit name or by Oculus viseme
- * name (names.ts: case-insensitive, exporter prefixes stripped, `_L` / `_R` spelled out), or, for a VRM, its five
- * vowel expressions and its blinks (vrm.ts); and a head bone to turn with the predicted head pose. No renderer here
- * (avatar-view.ts draws it), so it loads in Node too.
+ * A user's glTF avatar bound to this project's output (face-binding.ts finds what drives it): its morph targets found
+ * by ARKit name or by Oculus viseme name (names.ts: case-insensitive, exporter prefixes stripped, `_L` / `_R` spelled
+ * out), or, for a VRM, its five vowel expressions and its blinks (vrm.ts); and a head bone to turn with the predicted
+ * head pose. No renderer here (avatar-view.ts draws it), so it loads in Node too.
  */
 import * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
-import { VRM_VOWELS, readVrm, threeVrmOf, vowelsOf, type ThreeVrmLike, type VrmFile } from './vrm';
+import { ARKIT_INDEX, ARKIT_NAMES } from './names';
+import { VRM_BLINK_FLOOR, VRM_VOWELS, vowelsOf } from './vrm';
+import { bindFace, type AvatarScheme, type ExpressionDrive, type Target } from './face-binding';
+import { AvatarLoadError, bufferOf, folderOf, parentInScene } from './gltf-nodes';
 
-export class AvatarLoadError extends Error {
-  override name = 'AvatarLoadError';
-}
-
-/** One morph target driven by one output channel: influences[at] gets the channel's value x weight (summed where several drive it). */
-interface Target {
-  influences: number[];
-  at: number;
-  channel: number;
-  weight: number;
-}
-
-/** A VRM's expressions as three-vrm's manager drives them (the page's VRMLoaderPlugin): the vowels and blinks it has. */
-interface ThreeVrmFace {
-  manager: NonNullable<ThreeVrmLike['expressionManager']>;
-  vowels: boolean[];
-  /** Its blink expressions, by blink channel (0 left, 1 right, 2 both). */
-  blinks: [name: string, channel: number][];
-}
-
-export type AvatarScheme = 'arkit' | 'visemes' | 'vrm';
+export { AvatarLoadError, type AvatarScheme };
 
 export interface AvatarSummary {
   /**
@@ -38,9 +20,12 @@ export interface AvatarSummary {
    * for a VRM, its vowel expressions (aa ih ou ee oh, made from the visemes: vrm.ts) and its blink expressions.
    */
   scheme: AvatarScheme;
-  /** ARKit (or viseme, or VRM expression) names the avatar has, out of 52 (15, 8). */
+  /**
+   * What drives it: ARKit names (out of 52, with those of a three-vrm VRM's expressions named after them), viseme
+   * names (out of 15), or a VRM's vowel and blink expressions (out of 7).
+   */
   matched: string[];
-  /** The bone turned with the head pose, or null. */
+  /** The bone turned with the head pose (a VRM loaded with three-vrm: its normalized head), or null. */
   headBone: string | null;
 }
 
@@ -66,6 +51,8 @@ export class GltfAvatar {
   private idleBlink = 0;
   /** A VRM's vowels this frame (scheme 'vrm'). */
   private readonly vowels = new Float32Array(VRM_VOWELS.length);
+  private readonly blinkTargets: Target[];
+  private readonly expressions: ExpressionDrive | null;
 
   private constructor(
     readonly gltf: GLTF,
@@ -73,12 +60,14 @@ export class GltfAvatar {
     private readonly targets: Target[],
     readonly matched: string[],
     readonly head: THREE.Object3D | null,
-    /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
-    private readonly blinkTargets: Target[],
     readonly facing: '+z' | '-z',
-    /** A VRM loaded with three-vrm: its expressions are set through its manager, which vrm.update() applies. */
-    private readonly threeVrm: ThreeVrmFace | null = null,
+    /** eyeBlinkLeft / eyeBlinkRight targets (channel 0 / 1), whatever drives the rest of the face. */
+    blinkTargets: Target[],
+    /** Expressions set by name: three-vrm's manager (vrm.update() applies them), or the file's read here. */
+    expressions: ExpressionDrive | null,
   ) {
+    this.blinkTargets = blinkTargets;
+    this.expressions = expressions;
     if (head) this.rest.copy(head.quaternion);
   }
 
@@ -96,7 +85,11 @@ export class GltfAvatar {
     if (magic !== 'glTF' && firstChar !== '{') {
       throw new AvatarLoadError(firstChar === '<'
         ? `${source} is not a glTF file but an HTML page, as hosts send for a missing file: is the URL right?`
-        : `${source} is not a glTF file (a .glb starts with "glTF"; this one starts with ${JSON.stringify(magic)}): export the avatar as .glb`);
+        : `${source} is not a glTF file (a .glb or .vrm starts with "glTF"; this one starts with ${JSON.stringify(magic)}): export the avatar as glTF binary (.glb, or .vrm)`);
+    }
+    const declared = magic === 'glTF' && bytes.byteLength >= 12 ? new DataView(bytes).getUint32(8, true) : 0;
+    if (declared > bytes.byteLength) {
+      throw new AvatarLoadError(`${source} is cut short: its header says ${declared} bytes, ${bytes.byteLength} came (an interrupted download or upload?)`);
     }
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
     let gltf: GLTF;
@@ -116,83 +109,33 @@ export class GltfAvatar {
     if ((gltf as unknown as THREE.Object3D)?.isObject3D) {
       throw new TypeError(`GltfAvatar.bind(${source}): give what GLTFLoader gave (gltf), not its scene: GltfAvatar.bind(gltf, ...)`);
     }
+    if ((gltf as unknown as { humanoid?: unknown })?.humanoid && !(gltf as { parser?: unknown }).parser) {
+      throw new TypeError(`GltfAvatar.bind(${source}): give what GLTFLoader gave (gltf), not gltf.userData.vrm: GltfAvatar.bind(gltf, ...)`);
+    }
     if (!gltf?.scene) throw new AvatarLoadError(`${source} has no scene: export the avatar with its scene`);
-    const threeVrm = threeVrmOf(gltf);
-    const vrm = threeVrm ? null : readVrm(gltf);
-    const facing = options.facing ?? ((threeVrm?.meta?.metaVersion ?? vrm?.version) === '0' ? '-z' : '+z');
+    const face = bindFace(gltf, source, headBone);
+    const facing = options.facing ?? (face.vrmVersion === '0' ? '-z' : '+z');
     if (facing !== '+z' && facing !== '-z') throw new TypeError(`GltfAvatar.bind(${source}): facing is '+z' or '-z', not ${JSON.stringify(facing)}`);
-    const arkit: Target[] = [];
-    const visemes: Target[] = [];
-    const names = new Set<string>();
-    gltf.scene.traverse((o) => {
-      const mesh = o as THREE.Mesh;
-      if (!mesh.morphTargetDictionary || !mesh.morphTargetInfluences) return;
-      for (const [name, at] of Object.entries(mesh.morphTargetDictionary)) {
-        names.add(name);
-        const a = arkitIndexOf(name), v = visemeIndexOf(name);
-        if (a >= 0) arkit.push({ influences: mesh.morphTargetInfluences, at, channel: a, weight: 1 });
-        if (v >= 0) visemes.push({ influences: mesh.morphTargetInfluences, at, channel: v, weight: 1 });
-      }
-    });
-    // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
-    const arkitMouth = arkit.some((t) => /^(jaw|mouth)/.test(ARKIT_NAMES[t.channel]));
-    const has = (name: string) => (threeVrm ? threeVrm.expressionManager!.getExpression(name) != null : !!vrm?.expressions.get(name)?.length);
-    const vrmMouth = VRM_VOWELS.some(has);
-    if (!arkit.length && !visemes.length && !vrmMouth) {
-      const found = names.size
-        ? `its morph targets are: ${[...names].slice(0, 60).join(', ')}${names.size > 60 ? ', …' : ''}. Rename them`
-        : 'it has no morph targets at all: export it with its blend shapes (shape keys), named so';
-      throw new AvatarLoadError(`${source} has no morph targets named after ARKit's 52 blend shapes (jawOpen, eyeBlinkLeft, …) ` +
-        `or the 15 Oculus visemes (viseme_aa, viseme_PP, …)${threeVrm || vrm ? ', and its VRM expressions have no vowels (aa, ih, ou, ee, oh)' : ''}; ` +
-        `${found} (docs/embedding.md, "Avatars").`);
-    }
-    const scheme = arkitMouth || (!visemes.length && !vrmMouth) ? 'arkit' : visemes.length ? 'visemes' : 'vrm';
-    const head = headBone || !(threeVrm || vrm)
-      ? findHead(gltf.scene, source, headBone)
-      : threeVrm?.humanoid?.getNormalizedBoneNode('head') ?? vrm?.head ?? findHead(gltf.scene, source, null);
-    // Blinks: eyeBlinkLeft / Right (channels 0, 1), else a VRM's blinkLeft / Right, else its blink (2: both eyes).
-    const blinkNames = has('blinkLeft') && has('blinkRight') ? ['blinkLeft', 'blinkRight'] : has('blink') ? ['blink'] : [];
-    const vrmBlinkChannel = (name: string) => ['blinkLeft', 'blinkRight', 'blink'].indexOf(name);
-    let blinks = arkit.filter((t) => t.channel === ARKIT_INDEX.eyeBlinkLeft || t.channel === ARKIT_INDEX.eyeBlinkRight)
-      .map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
-    if (!blinks.length && vrm) blinks = blinkNames.flatMap((name) => vrm.expressions.get(name)!.map((b) => ({ ...b, channel: vrmBlinkChannel(name) })));
-    if (scheme !== 'vrm') {
-      const targets = scheme === 'arkit' ? arkit : visemes;
-      const all: readonly string[] = scheme === 'arkit' ? ARKIT_NAMES : VISEME_NAMES;
-      const matched = [...new Set(targets.map((t) => all[t.channel]))];
-      return new GltfAvatar(gltf, scheme, targets, matched, head, blinks, facing);
-    }
-    const vowels = VRM_VOWELS.map(has);
-    const matched = [...VRM_VOWELS.filter((_, k) => vowels[k]), ...blinkNames];
-    if (threeVrm) {
-      const face = { manager: threeVrm.expressionManager!, vowels, blinks: blinkNames.map((n) => [n, vrmBlinkChannel(n)] as [string, number]) };
-      return new GltfAvatar(gltf, scheme, [], matched, head, [], facing, face);
-    }
-    const targets = VRM_VOWELS.flatMap((name, channel) => (vrm as VrmFile).expressions.get(name)?.map((b) => ({ ...b, channel })) ?? []);
-    return new GltfAvatar(gltf, scheme, targets, matched, head, blinks, facing);
+    return new GltfAvatar(gltf, face.scheme, face.targets, face.matched, face.head, facing, face.blinkTargets, face.expressions);
   }
 
   get summary(): AvatarSummary {
     return { scheme: this.scheme, matched: this.matched, headBone: this.head?.name ?? null };
   }
 
-  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets, or a VRM's blink expressions). */
+  /** Whether the avatar can blink (it has eyeBlinkLeft / eyeBlinkRight targets, or blink expressions). */
   get canBlink(): boolean {
-    return this.blinkTargets.length > 0 || !!this.threeVrm?.blinks.length;
+    return this.blinkTargets.length > 0 || !!this.expressions?.blinks.length;
   }
 
   /**
-   * Set the morph targets from one frame of output: ARKit weights (52) and visemes (15), each from its index `at`
-   * (a VRM's vowels are made from the visemes). With three-vrm, its expressions are set, which vrm.update() applies.
+   * Set the face from one frame of output: ARKit weights (52) and visemes (15), each from its index `at` (a VRM's
+   * vowels are made from the visemes). Expressions of three-vrm's are set, and vrm.update() applies them.
    */
   setWeights(arkit: ArrayLike<number>, arkitAt: number, visemes: ArrayLike<number>, visemesAt: number): void {
-    let values: ArrayLike<number> = this.scheme === 'arkit' ? arkit : visemes;
-    let at = this.scheme === 'arkit' ? arkitAt : visemesAt;
-    if (this.scheme === 'vrm') {
-      values = vowelsOf(visemes, visemesAt, this.vowels);
-      at = 0;
-    }
-    this.writeTargets(values, at);
+    if (this.scheme === 'vrm') this.writeFace(vowelsOf(visemes, visemesAt, this.vowels), 0);
+    else if (this.scheme === 'arkit') this.writeFace(arkit, arkitAt);
+    else this.writeFace(visemes, visemesAt);
     this.modelBlink[0] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkLeft];
     this.modelBlink[1] = arkit[arkitAt + ARKIT_INDEX.eyeBlinkRight];
     this.applyBlink();
@@ -205,11 +148,11 @@ export class GltfAvatar {
   }
 
   /**
-   * Every driven morph target back to 0 and the head to its rest pose: after turns on top of the page's animation,
-   * the animation's rotation they turned (the page's, where it has set the bone since).
+   * Every driven morph target (and expression) back to 0 and the head to its rest pose: after turns on top of the
+   * page's animation, the animation's rotation they turned (the page's, where it has set the bone since).
    */
   reset(): void {
-    this.writeTargets(ZEROS, 0);
+    this.writeFace(ZEROS, 0);
     this.modelBlink.fill(0);
     this.applyBlink();
     const q = this.head?.quaternion; // (not turned since binding or the last reset: left as the page has it)
@@ -218,23 +161,35 @@ export class GltfAvatar {
     this.wroteOnTop = null;
   }
 
-  /** Each target to its channel's value x its weight (0 first: a VRM's expressions may share a morph target, and add). */
-  private writeTargets(values: ArrayLike<number>, at: number): void {
-    for (const t of this.targets) t.influences[t.at] = 0;
-    for (const t of this.targets) t.influences[t.at] += values[at + t.channel] * t.weight;
-    const face = this.threeVrm;
-    if (face) for (let k = 0; k < VRM_VOWELS.length; k++) if (face.vowels[k]) face.manager.setValue(VRM_VOWELS[k], values[at + k]);
+  /** Each target (and expression) to its channel's value, from index `at` of `values`. */
+  private writeFace(values: ArrayLike<number>, at: number): void {
+    for (let i = 0; i < this.targets.length; i++) {
+      const t = this.targets[i];
+      t.influences[t.at] = values[at + t.channel] * t.weight;
+    }
+    const e = this.expressions;
+    if (e) for (let i = 0; i < e.face.length; i++) e.manager.setValue(e.face[i][0], values[at + e.face[i][1]]);
   }
 
-  /** A blink channel's closure: 0 left, 1 right, 2 both (a VRM's one blink expression), with the idle blink on top. */
-  private blinkOf(channel: number): number {
+  /**
+   * A blink channel's closure: 0 left, 1 right, 2 both (a VRM's one blink expression), the idle blink on top. An
+   * expression gets nothing of the model's own weights below VRM_BLINK_FLOOR (vrm.ts).
+   */
+  private blinkOf(channel: number, floor = 0): number {
     const model = channel === 2 ? Math.max(this.modelBlink[0], this.modelBlink[1]) : this.modelBlink[channel];
-    return Math.max(model, this.idleBlink);
+    return Math.max(model >= floor ? model : 0, this.idleBlink);
   }
 
+  /** The blinks set, then (a VRM read here) its expressions applied to its morph targets. */
   private applyBlink(): void {
-    for (const t of this.blinkTargets) t.influences[t.at] = this.blinkOf(t.channel) * t.weight;
-    if (this.threeVrm) for (const [name, channel] of this.threeVrm.blinks) this.threeVrm.manager.setValue(name, this.blinkOf(channel));
+    for (let i = 0; i < this.blinkTargets.length; i++) {
+      const t = this.blinkTargets[i];
+      t.influences[t.at] = this.blinkOf(t.channel) * t.weight;
+    }
+    const e = this.expressions;
+    if (!e) return;
+    for (let i = 0; i < e.blinks.length; i++) e.manager.setValue(e.blinks[i][0], this.blinkOf(e.blinks[i][1], VRM_BLINK_FLOOR));
+    e.own?.update();
   }
 
   /**
@@ -273,57 +228,7 @@ export class GltfAvatar {
   }
 }
 
-/** The file's bytes as an ArrayBuffer of their own (a view's bytes copied out), or a TypeError saying what came. */
-function bufferOf(data: ArrayBuffer | ArrayBufferView, source: string): ArrayBuffer {
-  if (data instanceof ArrayBuffer) return data;
-  if (ArrayBuffer.isView(data)) return new Uint8Array(data.buffer, data.byteOffset, data.byteLength).slice().buffer;
-  const what = data === null ? 'null' : typeof data === 'object' ? (data as object).constructor?.name ?? 'an object' : typeof data;
-  throw new TypeError(`GltfAvatar.parse(${source}): give the file's bytes (an ArrayBuffer or a Uint8Array), not ${what}` +
-    (what === 'Blob' || what === 'File' ? ' (await its arrayBuffer() first)' : ''));
-}
-
-/** The folder a .gltf's external files are read from ('' for a blob: or data: URL, which has none). */
-function folderOf(source: string): string {
-  try {
-    const url = new URL(source, globalThis.location?.href ?? 'file:///');
-    return url.protocol === 'blob:' || url.protocol === 'data:' ? '' : new URL('.', url).href;
-  } catch {
-    return ''; // deliberate: a name that is no URL has no folder; an embedded .glb needs none
-  }
-}
-
 const ZEROS = new Float32Array(ARKIT_NAMES.length);
 const scratch = new THREE.Quaternion();
 const inverse = new THREE.Quaternion();
-const sceneWorld = new THREE.Quaternion();
-const parentWorld = new THREE.Quaternion();
 const axis = new THREE.Vector3();
-
-/** The rotation of the head's parent relative to the avatar's root (gltf.scene), from their world rotations now. */
-function parentInScene(head: THREE.Object3D, scene: THREE.Object3D): THREE.Quaternion {
-  if (!head.parent) return parentWorld.identity();
-  head.parent.getWorldQuaternion(parentWorld);
-  scene.getWorldQuaternion(sceneWorld);
-  return parentWorld.premultiply(sceneWorld.invert()); // scene^-1 * parent
-}
-
-/** The head bone: the named one, else a bone (or node) named Head / head, else one whose name ends in "head". */
-function findHead(scene: THREE.Object3D, source: string, name?: string | null): THREE.Object3D | null {
-  const nodes: THREE.Object3D[] = [];
-  scene.traverse((o) => nodes.push(o));
-  if (name) {
-    // three.js's loader spells node names its own way (`mixamorig:Head` -> `mixamorigHead`): either spelling is found.
-    const sanitised = THREE.PropertyBinding.sanitizeNodeName(name);
-    const found = nodes.find((o) => o.name === name) ?? nodes.find((o) => o.name === sanitised);
-    if (!found) {
-      const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
-      const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);
-      throw new AvatarLoadError(`${source} has no node named "${name}" (the head bone asked for: avatar-head-bone, or bind's headBone); ` +
-        `its ${bones.length ? 'bones' : 'nodes'} are: ${named.slice(0, 60).join(', ')}`);
-    }
-    return found;
-  }
-  return nodes.find((o) => o.name === 'Head' || o.name === 'head')
-    ?? nodes.find((o) => (o as THREE.Bone).isBone && /(^|[^a-z])head$/i.test(o.name.replace(/^mixamorig:?/i, '')))
-    ?? null;
-}

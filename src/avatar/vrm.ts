@@ -4,7 +4,9 @@
  * expressions too, and the humanoid names the head bone. Read here from a glTF loaded by a plain GLTFLoader (the
  * extension's JSON, its node and mesh indices mapped to three.js objects), or taken from @pixiv/three-vrm's VRM where
  * the page loaded it with VRMLoaderPlugin (`gltf.userData.vrm`): its expression manager and its normalized head bone,
- * which vrm.update() copies to the model. No import of three-vrm: it is the page's.
+ * which vrm.update() copies to the model. No import of three-vrm: it is the page's. Either way the expressions
+ * follow three-vrm's rules (VRMExpressionManager.update): a binary one is on above 0.5, and one that overrides the
+ * mouth or the blinks blocks them at any weight ('block') or scales them down by its weight ('blend').
  */
 import type * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
@@ -60,33 +62,116 @@ export interface VrmBind {
   weight: number;
 }
 
-/** What the element needs of @pixiv/three-vrm's VRM (gltf.userData.vrm), typed here so as not to import it. */
-export interface ThreeVrmLike {
-  meta?: { metaVersion?: string };
-  expressionManager?: { setValue(name: string, weight: number): void; getExpression(name: string): unknown };
-  humanoid?: { getNormalizedBoneNode(name: string): THREE.Object3D | null | undefined };
+type Override = 'none' | 'block' | 'blend';
+
+/** An expression as the file defines it (VRM 1.0's names; a VRM 0.x group's preset name mapped, else its own name). */
+export interface VrmExpression {
+  binds: VrmBind[];
+  isBinary: boolean;
+  overrideMouth: Override;
+  overrideBlink: Override;
 }
 
-/** A VRM read from its extension: the expressions' binds by preset name (VRM 1.0's names), the head bone, the version. */
+/** A VRM read from its extension: its expressions by name, the head bone, the version. */
 export interface VrmFile {
   version: '0' | '1';
-  expressions: Map<string, VrmBind[]>;
+  expressions: Map<string, VrmExpression>;
   head: THREE.Object3D | null;
+  /** Expressions with a bind to a node, mesh or morph target the file does not have (left out, as three-vrm does). */
+  unbound: string[];
 }
 
-/** VRM 0.x preset names as VRM 1.0 spells them (three-vrm's map; only those driven here). */
-const V0_PRESETS: Record<string, string> = { a: 'aa', i: 'ih', u: 'ou', e: 'ee', o: 'oh', blink: 'blink', blink_l: 'blinkLeft', blink_r: 'blinkRight' };
+/**
+ * The model's own eyeBlink weights below this close no VRM blink expression: they are small and steady (the model
+ * does not predict blinks), and three-vrm blocks the mouth at any weight of a blink expression that overrides it.
+ */
+export const VRM_BLINK_FLOOR = 0.1;
+
+/** What the avatar needs of three-vrm's VRM (gltf.userData.vrm), typed here so as not to import it. */
+export interface ThreeVrmLike {
+  meta?: { metaVersion?: string };
+  expressionManager?: ExpressionManagerLike & {
+    expressions: { expressionName: string; binds?: readonly { primitives?: readonly THREE.Mesh[]; index?: number }[] }[];
+  };
+  humanoid?: {
+    getNormalizedBoneNode(name: string): THREE.Object3D | null | undefined;
+    /** The model's own (raw) bones by humanoid name. */
+    humanBones?: Record<string, { node?: THREE.Object3D } | undefined>;
+  };
+}
+
+/** Expressions set by name: three-vrm's VRMExpressionManager (applied by vrm.update()), or VrmExpressions. */
+export interface ExpressionManagerLike {
+  setValue(name: string, weight: number): void;
+}
+
+const MOUTH = new Set<string>(VRM_VOWELS), BLINKS = new Set(['blink', 'blinkLeft', 'blinkRight']);
+
+/**
+ * A VRM's expressions applied to its morph targets where three-vrm is not there to (a plain GLTFLoader's glTF):
+ * setValue() as three-vrm's expression manager takes it, update() as its update() applies the weights.
+ */
+export class VrmExpressions implements ExpressionManagerLike {
+  private readonly entries: (VrmExpression & { weight: number; part: 'mouth' | 'blink' | null })[];
+  private readonly byName = new Map<string, VrmExpression & { weight: number }>();
+
+  constructor(file: VrmFile) {
+    this.entries = [...file.expressions].map(([name, e]) => {
+      const entry = { ...e, weight: 0, part: MOUTH.has(name) ? 'mouth' as const : BLINKS.has(name) ? 'blink' as const : null };
+      this.byName.set(name, entry);
+      return entry;
+    });
+  }
+
+  setValue(name: string, weight: number): void {
+    const entry = this.byName.get(name);
+    if (entry) entry.weight = Math.min(1, Math.max(0, weight));
+  }
+
+  /** Every morph target an expression binds to 0, then each expression's weight (binary, overridden) added. */
+  update(): void {
+    let mouth = 1, blink = 1;
+    for (const e of this.entries) {
+      mouth -= overrideAmount(e.overrideMouth, outputWeight(e));
+      blink -= overrideAmount(e.overrideBlink, outputWeight(e));
+    }
+    mouth = Math.max(0, mouth);
+    blink = Math.max(0, blink);
+    for (const e of this.entries) for (const b of e.binds) b.influences[b.at] = 0;
+    for (const e of this.entries) {
+      const w = outputWeight(e) * (e.part === 'mouth' ? mouth : e.part === 'blink' ? blink : 1);
+      if (w) for (const b of e.binds) b.influences[b.at] += w * b.weight;
+    }
+  }
+}
+
+const outputWeight = (e: { isBinary: boolean; weight: number }) => (e.isBinary ? (e.weight > 0.5 ? 1 : 0) : e.weight);
+const overrideAmount = (o: Override, weight: number) => (o === 'block' ? (weight > 0 ? 1 : 0) : o === 'blend' ? weight : 0);
+const override = (o: unknown): Override => (o === 'block' || o === 'blend' ? o : 'none');
+
+/** VRM 0.x preset names as VRM 1.0 spells them (three-vrm's map). */
+const V0_PRESETS: Record<string, string> = {
+  a: 'aa', i: 'ih', u: 'ou', e: 'ee', o: 'oh', blink: 'blink', blink_l: 'blinkLeft', blink_r: 'blinkRight', joy: 'happy', angry: 'angry',
+  sorrow: 'sad', fun: 'relaxed', lookup: 'lookUp', lookdown: 'lookDown', lookleft: 'lookLeft', lookright: 'lookRight', neutral: 'neutral',
+};
+
+interface SchemaExpression {
+  morphTargetBinds?: { node?: number; index?: number; weight?: number }[];
+  isBinary?: boolean;
+  overrideMouth?: string;
+  overrideBlink?: string;
+}
 
 interface GltfJson {
   nodes?: { mesh?: number }[];
   extensions?: {
     VRMC_vrm?: {
       humanoid?: { humanBones?: Record<string, { node?: number }> };
-      expressions?: { preset?: Record<string, { morphTargetBinds?: { node?: number; index?: number; weight?: number }[] } | undefined> };
+      expressions?: { preset?: Record<string, SchemaExpression | undefined>; custom?: Record<string, SchemaExpression | undefined> };
     };
     VRM?: {
       humanoid?: { humanBones?: { bone?: string; node?: number }[] };
-      blendShapeMaster?: { blendShapeGroups?: { presetName?: string; binds?: { mesh?: number; index?: number; weight?: number }[] }[] };
+      blendShapeMaster?: { blendShapeGroups?: { name?: string; presetName?: string; isBinary?: boolean; binds?: { mesh?: number; index?: number; weight?: number }[] }[] };
     };
   };
 }
@@ -94,15 +179,16 @@ interface GltfJson {
 interface Association { nodes?: number; meshes?: number }
 interface Parser { json?: GltfJson; associations?: Map<unknown, Association> }
 
-/** three-vrm's VRM where the page loaded the file with VRMLoaderPlugin (one with an expression manager), else null. */
+/** three-vrm's VRM where the page loaded the file with VRMLoaderPlugin, else null. */
 export function threeVrmOf(gltf: GLTF): ThreeVrmLike | null {
   const vrm = (gltf.userData as { vrm?: ThreeVrmLike } | undefined)?.vrm;
-  return vrm?.expressionManager ? vrm : null;
+  return vrm?.expressionManager || vrm?.humanoid ? vrm : null;
 }
 
 /**
  * The VRM extension of a glTF loaded by GLTFLoader (VRMC_vrm, else VRM 0.x's VRM), its indices mapped to the
  * scene's objects through the loader's associations; null when the file has neither, or the loader's parser is gone.
+ * A bind to a node, mesh or morph target the file does not have is left out, as three-vrm leaves it.
  */
 export function readVrm(gltf: GLTF): VrmFile | null {
   const parser = (gltf as unknown as { parser?: Parser }).parser;
@@ -116,38 +202,47 @@ export function readVrm(gltf: GLTF): VrmFile | null {
     const mesh = o as THREE.Mesh;
     if (a?.meshes !== undefined && mesh.morphTargetInfluences) meshes.set(a.meshes, [...(meshes.get(a.meshes) ?? []), mesh]);
   });
-  // A node's primitives: the node itself where its mesh has one primitive, else its children of that mesh.
+  // A node's primitives: the node itself where its mesh has one primitive, else its children of that mesh (not a
+  // child node that uses the same mesh).
+  const nodeObjects = new Set(nodes.values());
   const primitivesOf = (node: number): THREE.Mesh[] => {
     const object = nodes.get(node), mesh = json.nodes?.[node]?.mesh;
     if (!object || mesh === undefined) return [];
-    const own = meshes.get(mesh) ?? [];
-    return own.filter((m) => m === object || m.parent === object);
+    return (meshes.get(mesh) ?? []).filter((m) => m === object || (m.parent === object && !nodeObjects.has(m)));
   };
-  const expressions = new Map<string, VrmBind[]>();
-  const bind = (name: string, primitives: THREE.Mesh[], index: number | undefined, weight: number) => {
-    if (index === undefined) return;
-    for (const m of primitives) {
-      if (index < m.morphTargetInfluences!.length) expressions.set(name, [...(expressions.get(name) ?? []), { influences: m.morphTargetInfluences!, at: index, weight }]);
-    }
+  const expressions = new Map<string, VrmExpression>();
+  const add = (name: string, isBinary?: boolean, mouth?: string, blink?: string): VrmBind[] => {
+    const e = { binds: [], isBinary: !!isBinary, overrideMouth: override(mouth), overrideBlink: override(blink) };
+    expressions.set(name, e);
+    return e.binds;
+  };
+  const unbound = new Set<string>();
+  const bind = (name: string, binds: VrmBind[], primitives: THREE.Mesh[], index: number | undefined, weight: number) => {
+    const ok = primitives.length > 0 && Number.isInteger(index) && index! >= 0 && primitives.every((m) => index! < m.morphTargetInfluences!.length);
+    if (!ok) unbound.add(name);
+    else for (const m of primitives) binds.push({ influences: m.morphTargetInfluences!, at: index!, weight });
   };
   if (ext.VRMC_vrm) {
-    for (const [name, expression] of Object.entries(ext.VRMC_vrm.expressions?.preset ?? {})) {
-      for (const b of expression?.morphTargetBinds ?? []) if (b.node !== undefined) bind(name, primitivesOf(b.node), b.index, b.weight ?? 1);
+    const { preset = {}, custom = {} } = ext.VRMC_vrm.expressions ?? {};
+    for (const [name, e] of [...Object.entries(preset), ...Object.entries(custom)]) {
+      if (!e) continue;
+      const binds = add(name, e.isBinary, e.overrideMouth, e.overrideBlink);
+      for (const b of e.morphTargetBinds ?? []) bind(name, binds, b.node === undefined ? [] : primitivesOf(b.node), b.index, b.weight ?? 1);
     }
     const head = ext.VRMC_vrm.humanoid?.humanBones?.head?.node;
-    return { version: '1', expressions, head: head === undefined ? null : nodes.get(head) ?? null };
+    return { version: '1', expressions, head: head === undefined ? null : nodes.get(head) ?? null, unbound: [...unbound] };
   }
   const v0 = ext.VRM!;
   for (const group of v0.blendShapeMaster?.blendShapeGroups ?? []) {
-    const name = V0_PRESETS[group.presetName ?? ''];
-    if (!name) continue;
+    const name = V0_PRESETS[group.presetName ?? ''] ?? group.name;
+    if (!name || expressions.has(name)) continue; // (three-vrm keeps a preset's first group too)
+    const binds = add(name, group.isBinary);
     for (const b of group.binds ?? []) {
-      if (b.mesh === undefined) continue;
       // Every node using the mesh (three.js gives each its own objects), as three-vrm binds them.
-      const users = (json.nodes ?? []).flatMap((n, i) => (n.mesh === b.mesh ? primitivesOf(i) : []));
-      bind(name, users, b.index, (b.weight ?? 100) / 100); // VRM 0.x weighs binds 0-100
+      const users = b.mesh === undefined ? [] : (json.nodes ?? []).flatMap((n, i) => (n.mesh === b.mesh ? primitivesOf(i) : []));
+      bind(name, binds, users, b.index, (b.weight ?? 100) / 100); // VRM 0.x weighs binds 0-100
     }
   }
   const head = v0.humanoid?.humanBones?.find((b) => b.bone === 'head')?.node;
-  return { version: '0', expressions, head: head === undefined ? null : nodes.get(head) ?? null };
+  return { version: '0', expressions, head: head === undefined ? null : nodes.get(head) ?? null, unbound: [...unbound] };
 }

@@ -1,7 +1,8 @@
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { test, expect, imageStats } from './fixtures';
-import { SPEECH, FPS } from './helpers/audio';
+import { test, expect, imageStats, differingFraction } from './fixtures';
+import { SPEECH, FPS, phoneSegments } from './helpers/audio';
+import { addAvatarFace } from './helpers/avatar';
 import { GltfAvatar } from '../../src/avatar/gltf-avatar';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
 
@@ -12,20 +13,10 @@ import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
  * and viseme_PP on /p b m/); frame events carry them; the avatar's morph targets and head bone move and it
  * blinks; the three exports; clear errors for a file that is not glTF and for one with neither naming scheme.
  */
-type Phone = [string, number, number];
-const PHONES: Phone[] = JSON.parse(readFileSync(resolve(import.meta.dirname, '../fixtures/speech-kal.phones.json'), 'utf8')).phones;
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']);
 const BILABIALS = new Set(['P', 'B', 'M']);
 const AVATARS = resolve(import.meta.dirname, '../../examples/avatars');
 
-/** Per segment of `set`: the frames whose instant lies in it. */
-function segments(set: Set<string>, frames: number): number[][] {
-  return PHONES.filter(([p]) => set.has(p)).map(([, s, e]) => {
-    const out: number[] = [];
-    for (let f = Math.ceil(s * FPS); f < e * FPS && f < frames; f++) out.push(f);
-    return out;
-  }).filter((seg) => seg.length > 0);
-}
 const mean = (a: number[]) => a.reduce((s, x) => s + x, 0) / a.length;
 
 type FaceEl = HTMLElement & {
@@ -88,7 +79,7 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
   }, id);
   const arkit = await take('arkit');
   const visemes = await take('visemes');
-  const open = segments(OPEN_VOWELS, arkit.frames), closed = segments(BILABIALS, arkit.frames);
+  const open = phoneSegments(OPEN_VOWELS, arkit.frames), closed = phoneSegments(BILABIALS, arkit.frames);
   expect(open.length).toBeGreaterThanOrEqual(5);
   expect(closed.length).toBeGreaterThanOrEqual(5);
   const w = (name: string) => (f: number) => arkit.arkit[f * 52 + ARKIT_NAMES.indexOf(name as never)];
@@ -226,35 +217,13 @@ test('avatar-facing="-z" shows an avatar made facing -z (VRM 0.x) as a +z one', 
   const turned = editedAvatar('arkit-face.glb', (gltf) => { for (const n of gltf.scenes[0].nodes) gltf.nodes[n].rotation = [0, 1, 0, 0]; });
   const url = await page.evaluate((data) => URL.createObjectURL(new Blob([Uint8Array.from(atob(data), (c) => c.charCodeAt(0))])), turned);
   const shot = async (avatar: string, facing: string | null) => {
-    await page.evaluate(([a, f]) => new Promise<void>((resolve, reject) => {
-      document.querySelectorAll('talking-face').forEach((e) => e.remove());
-      const el = document.createElement('talking-face');
-      Object.assign(el.style, { width: '320px', height: '320px', display: 'block' });
-      el.setAttribute('backend', 'cpu');
-      el.setAttribute('hide-status', '');
-      el.setAttribute('avatar', a);
-      if (f) el.setAttribute('avatar-facing', f);
-      el.addEventListener('ready', () => setTimeout(resolve, 500)); // the rest's weights set, then drawn
-      el.addEventListener('error', (e) => reject(new Error((e as CustomEvent).detail.message)));
-      document.body.prepend(el);
-    }), [avatar, facing] as const);
+    await addAvatarFace(page, avatar, facing);
     return page.locator('talking-face').screenshot();
   };
   const plain = await shot('/examples/avatars/arkit-face.glb', null);
   const fixed = await shot(url, '-z');
   const away = await shot(url, null);
-  const differing = (a: Buffer, b: Buffer) => page.evaluate(async ([x, y]) => {
-    const pixels = async (b64: string) => {
-      const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
-      const c = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d')!;
-      c.drawImage(bmp, 0, 0);
-      return c.getImageData(0, 0, bmp.width, bmp.height).data;
-    };
-    const [p, q] = [await pixels(x), await pixels(y)];
-    let n = 0;
-    for (let i = 0; i < p.length; i += 4) if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 24) n++;
-    return n / (p.length / 4);
-  }, [a.toString('base64'), b.toString('base64')] as const);
+  const differing = (a: Buffer, b: Buffer) => differingFraction(page, a, b);
   expect(await differing(plain, fixed), 'turned back to the camera: the same picture').toBeLessThan(0.002);
   expect(await differing(plain, away), 'without the attribute: its back').toBeGreaterThan(0.05);
 });

@@ -79,3 +79,19 @@ export async function imageStats(page: Page, png: Buffer): Promise<ImageStats> {
     };
   }, png.toString('base64'));
 }
+
+/** The fraction of pixels whose colour differs (by more than 24 in R + G + B) between two screenshots of one size. */
+export async function differingFraction(page: Page, a: Buffer, b: Buffer): Promise<number> {
+  return page.evaluate(async ([x, y]) => {
+    const pixels = async (b64: string) => {
+      const bmp = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
+      const c = new OffscreenCanvas(bmp.width, bmp.height).getContext('2d')!;
+      c.drawImage(bmp, 0, 0);
+      return c.getImageData(0, 0, bmp.width, bmp.height).data;
+    };
+    const [p, q] = [await pixels(x), await pixels(y)];
+    let n = 0;
+    for (let i = 0; i < p.length; i += 4) if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 24) n++;
+    return n / (p.length / 4);
+  }, [a.toString('base64'), b.toString('base64')] as const);
+}

@@ -10,6 +10,18 @@ const MANIFEST = JSON.parse(readFileSync(resolve(import.meta.dirname, '../../../
 export const SAMPLE_RATE = MANIFEST.audio.sample_rate;
 export const FPS = MANIFEST.audio.fps;
 
+/** SPEECH's phones, force-aligned (tests/fixtures/speech-kal.phones.json): [ARPAbet phone, start s, end s]. */
+export const SPEECH_PHONES: [string, number, number][] = JSON.parse(readFileSync(resolve(import.meta.dirname, '../../fixtures/speech-kal.phones.json'), 'utf8')).phones;
+
+/** For each of SPEECH's phones in `set`, the frames (of `frames`) whose instant lies in it; empty ones left out. */
+export function phoneSegments(set: Set<string>, frames: number): number[][] {
+  return SPEECH_PHONES.filter(([p]) => set.has(p)).map(([, s, e]) => {
+    const out: number[] = [];
+    for (let f = Math.ceil(s * FPS); f < e * FPS && f < frames; f++) out.push(f);
+    return out;
+  }).filter((seg) => seg.length > 0);
+}
+
 export function speechSamples(): { samples: Float32Array; rate: number } {
   return { samples: readWav16(SPEECH), rate: SAMPLE_RATE };
 }

@@ -20,7 +20,7 @@ const ALLOWED: Record<string, string> = {
   'src/component/parts.ts: 100': 'CSS percentages, not the feature rate',
   'src/component/parts.ts: 50': "a CSS percentage (the announcer's clip-path), not millimetres",
   'src/avatar/vrm.ts: 100': "VRM 0.x's bind weights (0-100), not the feature rate",
-  'src/avatar/vrm-avatar.ts: 100': "a VRM 0.x bind's full weight (0-100), not the feature rate",
+  'src/avatar/vrm-test-avatar.ts: 100': "a VRM 0.x bind's full weight (0-100), not the feature rate",
   'src/model/fetch-body.ts: 30': 'seconds a download may bring nothing (STALL_SECONDS), not frames per second',
   'src/attention/simd/decoder.wat: 80': "byte offsets in a row of attention_d32h4's queries, keys and values, not Mel bands",
   'src/attention/simd/decoder.wat: 160': "byte offsets in a row of attention_d32h4's queries, keys and values, not the hop",

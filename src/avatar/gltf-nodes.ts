@@ -1,0 +1,61 @@
+/**
+ * A glTF avatar's nodes and bytes as gltf-avatar.ts and face-binding.ts need them: the error for a file that cannot
+ * be used, the bytes of a file given, the folder a .gltf's files are read from, the head bone, and the rotation of a
+ * node's parent relative to the avatar's root.
+ */
+import * as THREE from 'three';
+
+export class AvatarLoadError extends Error {
+  override name = 'AvatarLoadError';
+}
+
+/** The file's bytes as an ArrayBuffer of their own (a view's bytes copied out), or a TypeError saying what came. */
+export function bufferOf(data: ArrayBuffer | ArrayBufferView, source: string): ArrayBuffer {
+  if (data instanceof ArrayBuffer) return data;
+  if (ArrayBuffer.isView(data)) return new Uint8Array(data.buffer, data.byteOffset, data.byteLength).slice().buffer;
+  const what = data === null ? 'null' : typeof data === 'object' ? (data as object).constructor?.name ?? 'an object' : typeof data;
+  throw new TypeError(`GltfAvatar.parse(${source}): give the file's bytes (an ArrayBuffer or a Uint8Array), not ${what}` +
+    (what === 'Blob' || what === 'File' ? ' (await its arrayBuffer() first)' : ''));
+}
+
+/** The folder a .gltf's external files are read from ('' for a blob: or data: URL, which has none). */
+export function folderOf(source: string): string {
+  try {
+    const url = new URL(source, globalThis.location?.href ?? 'file:///');
+    return url.protocol === 'blob:' || url.protocol === 'data:' ? '' : new URL('.', url).href;
+  } catch {
+    return ''; // deliberate: a name that is no URL has no folder; an embedded .glb needs none
+  }
+}
+
+const sceneWorld = new THREE.Quaternion();
+const parentWorld = new THREE.Quaternion();
+
+/** The rotation of the head's parent relative to the avatar's root (gltf.scene), from their world rotations now. */
+export function parentInScene(head: THREE.Object3D, scene: THREE.Object3D): THREE.Quaternion {
+  if (!head.parent) return parentWorld.identity();
+  head.parent.getWorldQuaternion(parentWorld);
+  scene.getWorldQuaternion(sceneWorld);
+  return parentWorld.premultiply(sceneWorld.invert()); // scene^-1 * parent
+}
+
+/** The head bone: the named one, else a bone (or node) named Head / head, else one whose name ends in "head". */
+export function findHead(scene: THREE.Object3D, source: string, name?: string | null): THREE.Object3D | null {
+  const nodes: THREE.Object3D[] = [];
+  scene.traverse((o) => nodes.push(o));
+  if (name) {
+    // three.js's loader spells node names its own way (`mixamorig:Head` -> `mixamorigHead`): either spelling is found.
+    const sanitised = THREE.PropertyBinding.sanitizeNodeName(name);
+    const found = nodes.find((o) => o.name === name) ?? nodes.find((o) => o.name === sanitised);
+    if (!found) {
+      const bones = nodes.filter((o) => (o as THREE.Bone).isBone).map((o) => o.name);
+      const named = bones.length ? bones : nodes.map((o) => o.name).filter(Boolean);
+      throw new AvatarLoadError(`${source} has no node named "${name}" (the head bone asked for: avatar-head-bone, or bind's headBone); ` +
+        `its ${bones.length ? 'bones' : 'nodes'} are: ${named.slice(0, 60).join(', ')}`);
+    }
+    return found;
+  }
+  return nodes.find((o) => o.name === 'Head' || o.name === 'head')
+    ?? nodes.find((o) => (o as THREE.Bone).isBone && /(^|[^a-z])head$/i.test(o.name.replace(/^mixamorig:?/i, '')))
+    ?? null;
+}
