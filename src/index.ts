@@ -32,6 +32,7 @@ export { GltfAvatar, AvatarLoadError, type AvatarSummary, type AvatarBindOptions
 export { AvatarDriver, BLEND_IN_SECONDS, BLEND_OUT_SECONDS, type DrivenFrames, type DrivenLiveFrames } from './avatar/avatar-driver';
 export { Blinks } from './avatar/blinks';
 export { blendshapesJson, liveLinkFaceCsv, liveLinkTimecode, blendshapesGlb } from './avatar/export';
+export { vrmAnimation } from './avatar/vrm-animation';
 export { TalkingHeadDriver, talkingHeadAnim, talkingHeadAngles, TALKINGHEAD_SHAPES, TALKINGHEAD_HEAD, type TalkingHeadLike, type TalkingHeadOptions } from './avatar/talkinghead';
 export { avatarScene, visemeAsArkit, buildAvatarGlb } from './avatar/avatar-mesh';
 export { fullBodyScene, buildFullBodyAvatarGlb } from './avatar/full-body-rig';

@@ -72,6 +72,21 @@ export async function blendshapesGlb(animation: Animation, template: FaceTemplat
   const { scene, mesh, head } = avatarScene(template, basis, { morphs: 'arkit', name: 'face' });
   const F = animation.frames;
   const times = Float32Array.from({ length: F }, (_, f) => f / animation.fps);
+  const quats = poseQuaternions(animation);
+  const clip = new THREE.AnimationClip('speech', Math.max(F - 1, 0) / animation.fps, [
+    new THREE.NumberKeyframeTrack(`${mesh.name}.morphTargetInfluences`, times, b.arkit.slice(0, F * ARKIT_NAMES.length)),
+    new THREE.QuaternionKeyframeTrack(`${head.name}.quaternion`, times, quats),
+  ]);
+  const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
+  const bytes = (await new GLTFExporter().parseAsync(scene, { binary: true, animations: [clip] })) as ArrayBuffer;
+  mesh.geometry.dispose();
+  (mesh.material as THREE.Material).dispose();
+  return bytes;
+}
+
+/** The head pose's rotation of each frame as a quaternion [x, y, z, w] (F x 4), from its axis-angle. */
+export function poseQuaternions(animation: Animation): Float32Array {
+  const F = animation.frames;
   const quats = new Float32Array(F * 4);
   const q = new THREE.Quaternion();
   const axis = new THREE.Vector3();
@@ -82,13 +97,5 @@ export async function blendshapesGlb(animation: Animation, template: FaceTemplat
     else q.setFromAxisAngle(axis.set(p[0] / angle, p[1] / angle, p[2] / angle), angle);
     q.toArray(quats, f * 4);
   }
-  const clip = new THREE.AnimationClip('speech', Math.max(F - 1, 0) / animation.fps, [
-    new THREE.NumberKeyframeTrack(`${mesh.name}.morphTargetInfluences`, times, b.arkit.slice(0, F * ARKIT_NAMES.length)),
-    new THREE.QuaternionKeyframeTrack(`${head.name}.quaternion`, times, quats),
-  ]);
-  const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
-  const bytes = (await new GLTFExporter().parseAsync(scene, { binary: true, animations: [clip] })) as ArrayBuffer;
-  mesh.geometry.dispose();
-  (mesh.material as THREE.Material).dispose();
-  return bytes;
+  return quats;
 }

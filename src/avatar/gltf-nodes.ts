@@ -1,7 +1,7 @@
 /**
  * A glTF avatar's nodes and bytes as gltf-avatar.ts and face-binding.ts need them: the error for a file that cannot
  * be used, the bytes of a file given, the folder a .gltf's files are read from, the head bone, and the rotation of a
- * node's parent relative to the avatar's root.
+ * node's parent relative to the avatar's root; and a .glb's JSON edited (the VRM files this project writes).
  */
 import * as THREE from 'three';
 
@@ -58,4 +58,26 @@ export function findHead(scene: THREE.Object3D, source: string, name?: string | 
   return nodes.find((o) => o.name === 'Head' || o.name === 'head')
     ?? nodes.find((o) => (o as THREE.Bone).isBone && /(^|[^a-z])head$/i.test(o.name.replace(/^mixamorig:?/i, '')))
     ?? null;
+}
+
+/** A .glb with its JSON chunk changed by `edit` (the binary chunk as it was). */
+export function editGlbJson<J extends object>(glb: ArrayBuffer, edit: (json: J) => void): ArrayBuffer {
+  const view = new DataView(glb);
+  const jsonLength = view.getUint32(12, true);
+  const json = JSON.parse(new TextDecoder().decode(new Uint8Array(glb, 20, jsonLength))) as J;
+  edit(json);
+  let text = new TextEncoder().encode(JSON.stringify(json));
+  const padded = new Uint8Array(Math.ceil(text.length / 4) * 4).fill(0x20); // the JSON chunk is padded with spaces
+  padded.set(text);
+  text = padded;
+  const rest = new Uint8Array(glb, 20 + jsonLength); // the BIN chunk, with its header
+  const out = new Uint8Array(12 + 8 + text.length + rest.length);
+  const o = new DataView(out.buffer);
+  out.set(new Uint8Array(glb, 0, 12));
+  o.setUint32(8, out.length, true);
+  o.setUint32(12, text.length, true);
+  o.setUint32(16, 0x4e4f534a, true); // 'JSON'
+  out.set(text, 20);
+  out.set(rest, 20 + text.length);
+  return out.buffer;
 }

@@ -12,6 +12,7 @@ import { ARKIT_INDEX, ARKIT_NAMES, type ArkitName, type VisemeName } from './nam
 import { arkitBasis } from './basis';
 import { avatarScene, visemeAsArkit, type MorphAsArkit } from './avatar-mesh';
 import { fullBodyScene } from './full-body-rig';
+import { editGlbJson } from './gltf-nodes';
 
 const arkitMix = (weights: Partial<Record<ArkitName, number>>) => {
   const w = new Float32Array(ARKIT_NAMES.length);
@@ -67,7 +68,7 @@ export async function buildVrmAvatarGlb(template: FaceTemplate, version: '0' | '
     (o as THREE.Mesh).geometry.dispose();
     [(o as THREE.Mesh).material].flat().forEach((m) => m.dispose());
   });
-  return withJson(glb, (json) => addVrm(json, version));
+  return editGlbJson<GlbJson>(glb, (json) => addVrm(json, version));
 }
 
 function addVrm(json: GlbJson, version: '0' | '1'): void {
@@ -100,26 +101,4 @@ function addVrm(json: GlbJson, version: '0' | '1'): void {
       name: name.replace('Fcl_', ''), presetName: V0_NAMES[preset], binds: [{ mesh, index, weight: 100 }], materialValues: [], isBinary: false,
     })) },
   };
-}
-
-/** A .glb with its JSON chunk changed by `edit` (the binary chunk as it was). */
-function withJson(glb: ArrayBuffer, edit: (json: GlbJson) => void): ArrayBuffer {
-  const view = new DataView(glb);
-  const jsonLength = view.getUint32(12, true);
-  const json = JSON.parse(new TextDecoder().decode(new Uint8Array(glb, 20, jsonLength))) as GlbJson;
-  edit(json);
-  let text = new TextEncoder().encode(JSON.stringify(json));
-  const padded = new Uint8Array(Math.ceil(text.length / 4) * 4).fill(0x20); // the JSON chunk is padded with spaces
-  padded.set(text);
-  text = padded;
-  const rest = new Uint8Array(glb, 20 + jsonLength); // the BIN chunk, with its header
-  const out = new Uint8Array(12 + 8 + text.length + rest.length);
-  const o = new DataView(out.buffer);
-  out.set(new Uint8Array(glb, 0, 12));
-  o.setUint32(8, out.length, true);
-  o.setUint32(12, text.length, true);
-  o.setUint32(16, 0x4e4f534a, true); // 'JSON'
-  out.set(text, 20);
-  out.set(rest, 20 + text.length);
-  return out.buffer;
 }

@@ -3,6 +3,8 @@ import { resolve } from 'node:path';
 import { test, expect, imageStats, differingFraction } from './fixtures';
 import { SPEECH, FPS, phoneSegments } from './helpers/audio';
 import { addAvatarFace } from './helpers/avatar';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { VRMAnimationLoaderPlugin, type VRMAnimation } from '@pixiv/three-vrm-animation';
 import { GltfAvatar } from '../../src/avatar/gltf-avatar';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
 
@@ -11,7 +13,7 @@ import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
  * examples/avatar.html: the ARKit one and the viseme-only one speak tests/fixtures/speech-kal.wav; the weights
  * follow its phones (tests/fixtures/speech-kal.phones.json: jawOpen and viseme_aa on the open vowels, mouthClose
  * and viseme_PP on /p b m/); frame events carry them; the avatar's morph targets and head bone move and it
- * blinks; the three exports; clear errors for a file that is not glTF and for one with neither naming scheme.
+ * blinks; the four exports (JSON, CSV, .glb, .vrma); clear errors for a file that is not glTF and for one with neither naming scheme.
  */
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']);
 const BILABIALS = new Set(['P', 'B', 'M']);
@@ -130,7 +132,7 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
   await expect.poll(async () => (await watched()).maxBlink, { timeout: 15_000, message: 'the avatar blinks' }).toBeGreaterThan(0.5);
   for (const id of ['arkit', 'visemes']) expect((await events(id)).filter((e) => e.type === 'error')).toEqual([]);
 
-  // The three exports of the ARKit avatar's take.
+  // The four exports of the ARKit avatar's take.
   const download = async (button: string) => {
     const [d] = await Promise.all([page.waitForEvent('download'), page.locator(button).click()]);
     return readFileSync((await d.path())!);
@@ -154,6 +156,15 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
   expect(exported.gltf.animations).toHaveLength(1);
   expect(exported.gltf.animations[0].duration).toBeCloseTo((arkit.frames - 1) / FPS, 3);
   expect(exported.gltf.animations[0].tracks.map((t) => t.name).sort()).toEqual(['Head.quaternion', 'face.morphTargetInfluences']);
+  // The VRM Animation, as @pixiv/three-vrm-animation reads it (tests/unit/avatar/vrm-animation.test.ts plays one on a VRM).
+  const vrma = await download('#vrma');
+  const loader = new GLTFLoader();
+  loader.register((parser) => new VRMAnimationLoaderPlugin(parser));
+  const [motion] = (await loader.parseAsync(vrma.buffer.slice(vrma.byteOffset, vrma.byteOffset + vrma.byteLength) as ArrayBuffer, '')).userData.vrmAnimations as VRMAnimation[];
+  expect(motion.duration).toBeCloseTo((arkit.frames - 1) / FPS, 3);
+  expect([...motion.expressionTracks.preset.keys()]).toEqual(['aa', 'ih', 'ou', 'ee', 'oh']);
+  const aa = motion.expressionTracks.preset.get('aa')!.values;
+  expect(mean(open.flat().map((f) => aa[f])), 'aa on the open vowels').toBeGreaterThan(0.4);
 });
 
 /** The test avatar with its morph targets renamed (the JSON chunk of the .glb edited, the binary chunk kept). */
