@@ -1,13 +1,14 @@
 /**
  * What drives a glTF avatar's face (gltf-avatar.ts binds it): its morph targets found by ARKit or Oculus viseme name
  * (names.ts), or a VRM's expressions (vrm.ts); its blinks; its head bone. A VRM's morph target that one of its
- * expressions binds is driven through an expression named after its shape (a "perfect sync" VRM's) or not at all:
- * its expressions set it (three-vrm's vrm.update(), or VrmExpressions here), so the plain loader and three-vrm agree.
+ * expressions binds is set by its expressions only (three-vrm's vrm.update(), or VrmExpressions here, so the plain
+ * loader and three-vrm agree): through an expression named after its shape (a "perfect sync" VRM's), or through the
+ * vowels that bind it.
  */
 import type * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES, arkitIndexOf, visemeIndexOf } from './names';
-import { VRM_VOWELS, VrmExpressions, readVrm, threeVrmOf, type ExpressionManagerLike, type ThreeVrmLike, type VrmFile } from './vrm';
+import { VRM_BLINK_FLOOR, VRM_VOWELS, VrmExpressions, readVrm, threeVrmOf, type ExpressionManagerLike, type ThreeVrmLike, type VrmFile } from './vrm';
 import { AvatarLoadError, findHead } from './gltf-nodes';
 
 export type AvatarScheme = 'arkit' | 'visemes' | 'vrm';
@@ -26,8 +27,8 @@ export interface ExpressionDrive {
   own: VrmExpressions | null;
   /** [expression, channel of the frame's values (ARKit's, or the vowels')]. */
   face: [string, number][];
-  /** [expression, blink channel: 0 left, 1 right, 2 both]. */
-  blinks: [string, number][];
+  /** [expression, blink channel: 0 left, 1 right, 2 both, the floor of the model's own weights it gets]. */
+  blinks: [string, number, number][];
 }
 
 export interface FaceBinding {
@@ -44,59 +45,97 @@ export interface FaceBinding {
 
 const isMouth = (channel: number) => /^(jaw|mouth)/.test(ARKIT_NAMES[channel]);
 const isBlink = (channel: number) => channel === ARKIT_INDEX.eyeBlinkLeft || channel === ARKIT_INDEX.eyeBlinkRight;
+const VRM_BLINKS = ['blinkLeft', 'blinkRight', 'blink'];
+
+/** A VRM's expressions as the binding sees them: their names, and whether one moves a morph target. */
+interface Expressions {
+  names: string[];
+  moves(name: string): boolean;
+}
 
 export function bindFace(gltf: GLTF, source: string, headBone?: string | null): FaceBinding {
   const threeVrm = threeVrmOf(gltf);
   const file = threeVrm ? null : readVrm(gltf);
-  const bound = threeVrm || file ? boundByExpressions(threeVrm, file) : null;
+  const vrm = expressionsOf(threeVrm, file);
+  const bound = vrm ? boundByExpressions(threeVrm, file) : null;
   const arkit: Target[] = [], visemes: Target[] = [];
-  const names = new Set<string>();
+  const names = new Set<string>(), boundNames: string[] = [];
   gltf.scene.traverse((o) => {
     const mesh = o as THREE.Mesh;
     if (!mesh.morphTargetDictionary || !mesh.morphTargetInfluences) return;
     for (const [name, at] of Object.entries(mesh.morphTargetDictionary)) {
       names.add(name);
-      if (bound?.get(mesh.morphTargetInfluences)?.has(at)) continue; // a VRM's expression sets it: through one only
       const a = arkitIndexOf(name), v = visemeIndexOf(name);
+      if (bound?.get(mesh.morphTargetInfluences)?.has(at)) { // a VRM's expression sets it: through one only
+        if (a >= 0 || v >= 0) boundNames.push(name);
+        continue;
+      }
       if (a >= 0) arkit.push({ influences: mesh.morphTargetInfluences, at, channel: a, weight: 1 });
       if (v >= 0) visemes.push({ influences: mesh.morphTargetInfluences, at, channel: v, weight: 1 });
     }
   });
-  const threeExpressions = threeVrm?.expressionManager?.expressions ?? [];
-  const expressionNames = threeVrm ? threeExpressions.map((e) => e.expressionName) : [...(file?.expressions.keys() ?? [])];
-  // An expression that moves a morph target (three-vrm's binds also set materials).
-  const moves = (name: string) => threeVrm
-    ? !!threeExpressions.find((e) => e.expressionName === name)?.binds?.some((b) => b.primitives?.length)
-    : !!file?.expressions.get(name)?.binds.length;
   // A VRM's expressions named after ARKit's shapes (a perfect-sync VRM's): their morph targets are reached so.
-  const arkitExpressions = expressionNames.map((n) => [n, arkitIndexOf(n)] as [string, number]).filter(([n, c]) => c >= 0 && moves(n));
-  // A few ARKit eye shapes beside the visemes (blinks, often) do not make an ARKit rig: the mouth decides.
-  const arkitMouth = arkit.some((t) => isMouth(t.channel)) || arkitExpressions.some(([, c]) => isMouth(c));
-  const vowels = VRM_VOWELS.map(moves);
-  if (!arkit.length && !arkitExpressions.length && !visemes.length && !vowels.some(Boolean)) {
-    throw noTargets(source, names, threeVrm || file ? expressionNames : null, file?.unbound ?? []);
-  }
-  const scheme: AvatarScheme = arkitMouth || (!visemes.length && !vowels.some(Boolean)) ? 'arkit' : visemes.length ? 'visemes' : 'vrm';
+  const arkitExpressions = (vrm?.names ?? []).map((n) => [n, arkitIndexOf(n)] as [string, number]).filter(([n, c]) => c >= 0 && vrm!.moves(n));
+  const vowels = VRM_VOWELS.map((v) => !!vrm?.moves(v));
+  const scheme = schemeOf(arkit, arkitExpressions, visemes, vowels, !!vrm);
+  if (!scheme) throw noTargets(source, names, vrm ? { names: vrm.names, unbound: (file ?? readVrm(gltf))?.unbound ?? [], boundNames } : null);
 
-  const vrmVersion = threeVrm ? threeVrm.meta?.metaVersion ?? null : file?.version ?? null;
   const manager = threeVrm?.expressionManager ?? (file ? new VrmExpressions(file) : null);
-  // Blinks: ARKit's eyeBlinkLeft / Right (targets, or three-vrm's expressions so named), else a VRM's blinkLeft and
-  // blinkRight, else its blink (channel 2: both eyes).
-  const blinkTargets = arkit.filter((t) => isBlink(t.channel)).map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
-  let blinks = arkitExpressions.filter(([, c]) => isBlink(c)).map(([n, c]) => [n, c === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1] as [string, number]);
-  const vrmBlinks = moves('blinkLeft') && moves('blinkRight') ? ['blinkLeft', 'blinkRight'] : moves('blink') ? ['blink'] : [];
-  const blinkByVrm = !blinkTargets.length && !blinks.length && vrmBlinks.length > 0;
-  if (blinkByVrm) blinks = vrmBlinks.map((name) => [name, ['blinkLeft', 'blinkRight', 'blink'].indexOf(name)]);
+  const { blinkTargets, blinks, vrmBlinks } = blinksOf(arkit, arkitExpressions, vrm);
   const face: [string, number][] = scheme === 'arkit' ? arkitExpressions.filter(([, c]) => !isBlink(c))
     : scheme === 'vrm' ? VRM_VOWELS.map((name, k) => [name, k] as [string, number]).filter((_, k) => vowels[k]) : [];
   const expressions = manager && (face.length || blinks.length) ? { manager, own: manager instanceof VrmExpressions ? manager : null, face, blinks } : null;
-
   const targets = scheme === 'arkit' ? arkit : scheme === 'visemes' ? visemes : [];
   const matched = scheme === 'arkit'
     ? [...new Set([...arkit.map((t) => t.channel), ...arkitExpressions.map(([, c]) => c)])].sort((x, y) => x - y).map((c) => ARKIT_NAMES[c])
     : scheme === 'visemes' ? [...new Set(visemes.map((t) => VISEME_NAMES[t.channel]))] : face.map(([name]) => name);
-  if (blinkByVrm) matched.push(...vrmBlinks);
+  matched.push(...vrmBlinks);
+  const vrmVersion = threeVrm ? threeVrm.meta?.metaVersion ?? null : file?.version ?? null;
   return { scheme, targets, blinkTargets, expressions, matched, head: headOf(gltf, source, headBone, threeVrm, file), vrmVersion };
+}
+
+/** A VRM's expressions, from three-vrm's manager or the file; null for an avatar that is no VRM. */
+function expressionsOf(threeVrm: ThreeVrmLike | null, file: VrmFile | null): Expressions | null {
+  if (threeVrm) {
+    const list = threeVrm.expressionManager?.expressions ?? [];
+    // (three-vrm's binds also set materials: one that moves a morph target has primitives)
+    return { names: list.map((e) => e.expressionName), moves: (name) => !!list.find((e) => e.expressionName === name)?.binds?.some((b) => b.primitives?.length) };
+  }
+  return file ? { names: [...file.expressions.keys()], moves: (name) => !!file.expressions.get(name)?.binds.length } : null;
+}
+
+/**
+ * Which output drives the face, or null for nothing to drive. ARKit when it has an ARKit mouth or jaw shape, else the
+ * visemes when it has viseme targets, else a VRM's vowels; an avatar with only ARKit eye shapes is ARKit's too. For a
+ * VRM, only a scheme that opens the mouth: ARKit where jawOpen is reached (a target no expression binds, or an
+ * expression named so), the visemes where viseme_aa is; else its vowels, whatever else it has (a VRM whose vowels
+ * bind its viseme or ARKit targets leaves the others alone, and they cannot open its mouth).
+ */
+function schemeOf(arkit: Target[], arkitExpressions: [string, number][], visemes: Target[], vowels: boolean[], isVrm: boolean): AvatarScheme | null {
+  const anyVowel = vowels.some(Boolean);
+  const arkitMouth = isVrm
+    ? arkit.some((t) => t.channel === ARKIT_INDEX.jawOpen) || arkitExpressions.some(([, c]) => c === ARKIT_INDEX.jawOpen)
+    : arkit.some((t) => isMouth(t.channel));
+  const visemeMouth = isVrm ? visemes.some((t) => VISEME_NAMES[t.channel] === 'viseme_aa') : visemes.length > 0;
+  if (arkitMouth) return 'arkit';
+  if (visemeMouth) return 'visemes';
+  if (anyVowel) return 'vrm';
+  return arkit.length || arkitExpressions.length || visemes.length ? (visemes.length && !arkit.length && !arkitExpressions.length ? 'visemes' : 'arkit') : null;
+}
+
+/**
+ * The blinks: ARKit's eyeBlinkLeft / Right (targets, or a VRM's expressions so named), else a VRM's blinkLeft and
+ * blinkRight, else its blink (channel 2: both eyes); `vrmBlinks` names the VRM's, where they are used. Each
+ * expression's third value is the floor below which the model's own weights do not reach it (VRM_BLINK_FLOOR, for
+ * VRM's blink expressions: vrm.ts).
+ */
+function blinksOf(arkit: Target[], arkitExpressions: [string, number][], vrm: Expressions | null) {
+  const blinkTargets = arkit.filter((t) => isBlink(t.channel)).map((t) => ({ ...t, channel: t.channel === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1 }));
+  const named = arkitExpressions.filter(([, c]) => isBlink(c)).map(([n, c]) => [n, c === ARKIT_INDEX.eyeBlinkLeft ? 0 : 1, 0] as [string, number, number]);
+  const own = vrm?.moves('blinkLeft') && vrm.moves('blinkRight') ? ['blinkLeft', 'blinkRight'] : vrm?.moves('blink') ? ['blink'] : [];
+  const byVrm = !blinkTargets.length && !named.length && own.length > 0;
+  const blinks = byVrm ? own.map((name) => [name, VRM_BLINKS.indexOf(name), VRM_BLINK_FLOOR] as [string, number, number]) : named;
+  return { blinkTargets, blinks, vrmBlinks: byVrm ? own : [] };
 }
 
 /**
@@ -131,13 +170,14 @@ function boundByExpressions(vrm: ThreeVrmLike | null, file: VrmFile | null): Map
   return out;
 }
 
-/** The message for an avatar with nothing to drive: its morph targets, or a VRM's expressions and its binds to nothing. */
-function noTargets(source: string, names: Set<string>, expressions: string[] | null, unbound: string[]): AvatarLoadError {
+/** The message for an avatar with nothing to drive: its morph targets, or a VRM's expressions and what they hold. */
+function noTargets(source: string, names: Set<string>, vrm: { names: string[]; unbound: string[]; boundNames: string[] } | null): AvatarLoadError {
   const list = (a: string[]) => `${a.slice(0, 60).join(', ')}${a.length > 60 ? ', …' : ''}`;
-  if (expressions) {
-    const lost = unbound.length ? ` (${list(unbound)} bind morph targets or nodes the file does not have)` : '';
+  if (vrm) {
+    const lost = vrm.unbound.length ? ` (${list(vrm.unbound)} bind morph targets or nodes the file does not have)` : '';
+    const held = vrm.boundNames.length ? ` Its morph targets ${list([...new Set(vrm.boundNames)])} are set by its other expressions only.` : '';
     return new AvatarLoadError(`${source} is a VRM with no vowel expressions (aa, ih, ou, ee, oh) that move a morph target, and no morph ` +
-      `targets named after ARKit's 52 blend shapes or the 15 Oculus visemes; its expressions are: ${list(expressions) || 'none'}${lost}. ` +
+      `targets named after ARKit's 52 blend shapes or the 15 Oculus visemes that it leaves free; its expressions are: ${list(vrm.names) || 'none'}${lost}.${held} ` +
       `Bind its mouth's morph targets to aa, ih, ou, ee and oh (VRoid Studio; UniVRM's blend-shape clips) (docs/embedding.md, "Avatars").`);
   }
   const found = names.size

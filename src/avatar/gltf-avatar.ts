@@ -7,7 +7,7 @@
 import * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
 import { ARKIT_INDEX, ARKIT_NAMES } from './names';
-import { VRM_BLINK_FLOOR, VRM_VOWELS, vowelsOf } from './vrm';
+import { VRM_VOWELS, vowelsOf } from './vrm';
 import { bindFace, type AvatarScheme, type ExpressionDrive, type Target } from './face-binding';
 import { AvatarLoadError, bufferOf, folderOf, parentInScene } from './gltf-nodes';
 
@@ -21,8 +21,9 @@ export interface AvatarSummary {
    */
   scheme: AvatarScheme;
   /**
-   * What drives it: ARKit names (out of 52, with those of a three-vrm VRM's expressions named after them), viseme
-   * names (out of 15), or a VRM's vowel and blink expressions (out of 7).
+   * What drives it: ARKit names (out of 52, with a VRM's expressions named after them), viseme names (out of 15), or a
+   * VRM's vowel expressions (out of 5); then a VRM's blink expressions where they are its blinks (blinkLeft and
+   * blinkRight, or blink).
    */
   matched: string[];
   /** The bone turned with the head pose (a VRM loaded with three-vrm: its normalized head), or null. */
@@ -172,12 +173,12 @@ export class GltfAvatar {
   }
 
   /**
-   * A blink channel's closure: 0 left, 1 right, 2 both (a VRM's one blink expression), the idle blink on top. An
-   * expression gets nothing of the model's own weights below VRM_BLINK_FLOOR (vrm.ts).
+   * A blink channel's closure: 0 left, 1 right, 2 both (a VRM's one blink expression), the idle blink on top. The
+   * model's own weight counts from `floor` up (a VRM's blink expressions: VRM_BLINK_FLOOR, vrm.ts), stretched to 1.
    */
   private blinkOf(channel: number, floor = 0): number {
     const model = channel === 2 ? Math.max(this.modelBlink[0], this.modelBlink[1]) : this.modelBlink[channel];
-    return Math.max(model >= floor ? model : 0, this.idleBlink);
+    return Math.max(Math.max(0, model - floor) / (1 - floor), this.idleBlink);
   }
 
   /** The blinks set, then (a VRM read here) its expressions applied to its morph targets. */
@@ -188,7 +189,7 @@ export class GltfAvatar {
     }
     const e = this.expressions;
     if (!e) return;
-    for (let i = 0; i < e.blinks.length; i++) e.manager.setValue(e.blinks[i][0], this.blinkOf(e.blinks[i][1], VRM_BLINK_FLOOR));
+    for (let i = 0; i < e.blinks.length; i++) e.manager.setValue(e.blinks[i][0], this.blinkOf(e.blinks[i][1], e.blinks[i][2]));
     e.own?.update();
   }
 

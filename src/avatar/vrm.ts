@@ -5,8 +5,9 @@
  * extension's JSON, its node and mesh indices mapped to three.js objects), or taken from @pixiv/three-vrm's VRM where
  * the page loaded it with VRMLoaderPlugin (`gltf.userData.vrm`): its expression manager and its normalized head bone,
  * which vrm.update() copies to the model. No import of three-vrm: it is the page's. Either way the expressions
- * follow three-vrm's rules (VRMExpressionManager.update): a binary one is on above 0.5, and one that overrides the
- * mouth or the blinks blocks them at any weight ('block') or scales them down by its weight ('blend').
+ * follow three-vrm's rules (VRMExpressionManager.update): a binary one is on above 0.5 (and off where an override
+ * scales it below 1), and one that overrides the mouth or the blinks blocks them at any weight ('block') or scales
+ * them down by its weight ('blend').
  */
 import type * as THREE from 'three';
 import type { GLTF } from 'three/addons/loaders/GLTFLoader.js';
@@ -82,8 +83,9 @@ export interface VrmFile {
 }
 
 /**
- * The model's own eyeBlink weights below this close no VRM blink expression: they are small and steady (the model
- * does not predict blinks), and three-vrm blocks the mouth at any weight of a blink expression that overrides it.
+ * The model's own eyeBlink weights count from this up for a VRM's blink expressions (stretched: 1 stays 1): they are
+ * small and steady (the model does not predict blinks), and three-vrm blocks the mouth at any weight of a blink
+ * expression that overrides it.
  */
 export const VRM_BLINK_FLOOR = 0.1;
 
@@ -139,7 +141,8 @@ export class VrmExpressions implements ExpressionManagerLike {
     blink = Math.max(0, blink);
     for (const e of this.entries) for (const b of e.binds) b.influences[b.at] = 0;
     for (const e of this.entries) {
-      const w = outputWeight(e) * (e.part === 'mouth' ? mouth : e.part === 'blink' ? blink : 1);
+      let w = outputWeight(e) * (e.part === 'mouth' ? mouth : e.part === 'blink' ? blink : 1);
+      if (e.isBinary && w < 1) w = 0; // (a binary one scaled down by an override is off)
       if (w) for (const b of e.binds) b.influences[b.at] += w * b.weight;
     }
   }
@@ -148,6 +151,10 @@ export class VrmExpressions implements ExpressionManagerLike {
 const outputWeight = (e: { isBinary: boolean; weight: number }) => (e.isBinary ? (e.weight > 0.5 ? 1 : 0) : e.weight);
 const overrideAmount = (o: Override, weight: number) => (o === 'block' ? (weight > 0 ? 1 : 0) : o === 'blend' ? weight : 0);
 const override = (o: unknown): Override => (o === 'block' || o === 'blend' ? o : 'none');
+
+/** VRM 1.0's preset expressions. */
+const V1_PRESETS = new Set([...VRM_VOWELS, 'happy', 'angry', 'sad', 'relaxed', 'surprised', 'blink', 'blinkLeft', 'blinkRight',
+  'lookUp', 'lookDown', 'lookLeft', 'lookRight', 'neutral']);
 
 /** VRM 0.x preset names as VRM 1.0 spells them (three-vrm's map). */
 const V0_PRESETS: Record<string, string> = {
@@ -224,7 +231,9 @@ export function readVrm(gltf: GLTF): VrmFile | null {
   };
   if (ext.VRMC_vrm) {
     const { preset = {}, custom = {} } = ext.VRMC_vrm.expressions ?? {};
-    for (const [name, e] of [...Object.entries(preset), ...Object.entries(custom)]) {
+    // As three-vrm: a preset of another name, and a custom expression named as a preset, are left out.
+    const named = [...Object.entries(preset).filter(([n]) => V1_PRESETS.has(n)), ...Object.entries(custom).filter(([n]) => !V1_PRESETS.has(n))];
+    for (const [name, e] of named) {
       if (!e) continue;
       const binds = add(name, e.isBinary, e.overrideMouth, e.overrideBlink);
       for (const b of e.morphTargetBinds ?? []) bind(name, binds, b.node === undefined ? [] : primitivesOf(b.node), b.index, b.weight ?? 1);
