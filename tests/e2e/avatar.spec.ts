@@ -42,13 +42,14 @@ test('an ARKit avatar and a viseme avatar speak through one attribute; the weigh
   await page.goto('/examples/avatar.html');
   type Event = { type: string; detail: Record<string, any> };
   const events = (id: string) => page.evaluate((i) => ((globalThis as unknown as { avatarEvents: Record<string, Event[]> }).avatarEvents[i] ?? []), id);
-  await expect.poll(async () => (await events('arkit')).some((e) => e.type === 'ready') && (await events('visemes')).some((e) => e.type === 'ready'), { timeout: 90_000 }).toBe(true);
+  await expect.poll(async () => (await Promise.all(['arkit', 'visemes', 'vrm'].map(async (id) => (await events(id)).some((e) => e.type === 'ready')))).every(Boolean), { timeout: 90_000 }).toBe(true);
   const ready = async (id: string) => (await events(id)).find((e) => e.type === 'ready')!.detail.avatar;
   expect(await ready('arkit')).toEqual({ scheme: 'arkit', matched: [...ARKIT_NAMES], headBone: 'Head' });
   expect((await ready('visemes')).scheme).toBe('visemes');
   expect((await ready('visemes')).matched).toHaveLength(15);
-  // Both avatars are drawn.
-  for (const id of ['#arkit', '#visemes']) expect((await imageStats(page, await page.locator(id).screenshot())).foregroundFraction, id).toBeGreaterThan(0.05);
+  expect(await ready('vrm')).toEqual({ scheme: 'vrm', matched: ['aa', 'ih', 'ou', 'ee', 'oh', 'blinkLeft', 'blinkRight'], headBone: 'Head' });
+  // The three avatars are drawn.
+  for (const id of ['#arkit', '#visemes', '#vrm']) expect((await imageStats(page, await page.locator(id).screenshot())).foregroundFraction, id).toBeGreaterThan(0.05);
 
   // The ARKit avatar blinks (idle blinks through eyeBlinkLeft / eyeBlinkRight): watch its influences every frame.
   await page.evaluate(() => {

@@ -1,6 +1,6 @@
 import { readFileSync } from 'node:fs';
 import { test, expect, differingFraction } from './fixtures';
-import { SPEECH, phoneSegments } from './helpers/audio';
+import { SPEECH, SPEECH_PHONES, phoneSegments } from './helpers/audio';
 import { addAvatarFace } from './helpers/avatar';
 
 /**
@@ -74,10 +74,20 @@ test('a VRM avatar speaks through its vowel expressions: open on open vowels, cl
   expect(closed.length).toBeGreaterThanOrEqual(5);
   const onOpen = mean(open.flat().map((f) => opening[f]));
   const closedMinima = closed.map((seg) => Math.min(...seg.map((f) => opening[f])));
+  // Closures as a viewer sees them: a segment is closed where its most closed frame opens the mouth under 0.15 (of
+  // the open vowels' ~0.9). Hits on /p b m/, false alarms in the other speech, and chance: the same output shifted
+  // in time (by 8 to 24 frames, round the clip) against the phones.
+  const shut = (series: number[], segs: number[][]) => segs.filter((seg) => Math.min(...seg.map((f) => series[f])) < 0.15).length / segs.length;
+  const other = phoneSegments(new Set(SPEECH_PHONES.map(([p]) => p).filter((p) => p !== 'SIL' && !BILABIALS.has(p))), opening.length);
+  const shifted = (k: number) => opening.map((_, f) => opening[(f + k) % opening.length]);
+  const [hits, falseAlarms] = [shut(opening, closed), shut(opening, other)];
+  const chance = mean(Array.from({ length: 17 }, (_, i) => shut(shifted(8 + i), closed)));
   // The figures docs/avatar.md quotes ("VRM"): printed by this test.
-  console.log(`VRM mouth on speech-kal.wav: open vowels ${onOpen.toFixed(2)}; each /p b m/'s most closed frame ${closedMinima.map((x) => x.toFixed(2)).join(', ')}`);
+  console.log(`VRM mouth on speech-kal.wav: open vowels ${onOpen.toFixed(2)}; each /p b m/'s most closed frame ${closedMinima.map((x) => x.toFixed(2)).join(', ')}; ` +
+    `closed on ${(100 * hits).toFixed(0)}% of /p b m/ (${closed.length}), ${(100 * falseAlarms).toFixed(0)}% of the other speech (${other.length}), chance ${(100 * chance).toFixed(0)}%`);
   expect(onOpen, 'the open vowels open the mouth').toBeGreaterThan(0.4);
   expect(mean(closedMinima), `each /p b m/'s most closed frame: ${closedMinima.map((x) => x.toFixed(2))}; open vowels ${onOpen.toFixed(2)}`).toBeLessThan(0.3 * onOpen);
+  expect(hits, 'closed on /p b m/ more than in the other speech, and more than by chance').toBeGreaterThan(Math.max(falseAlarms, chance) + 0.2);
 });
 
 test('a VRM 0.x avatar, made facing -z, is turned to the camera: as a VRM 1.0 one looks, unless avatar-facing says +z', async ({ page }) => {
