@@ -53,6 +53,7 @@ interface Expressions {
   moves(name: string): boolean;
 }
 
+/** What drives `gltf`'s face (`source` names it in messages; `headBone`: the node to turn, if named); throws AvatarLoadError for nothing. */
 export function bindFace(gltf: GLTF, source: string, headBone?: string | null): FaceBinding {
   const threeVrm = threeVrmOf(gltf);
   const file = threeVrm ? null : readVrm(gltf);
@@ -120,7 +121,9 @@ function schemeOf(arkit: Target[], arkitExpressions: [string, number][], visemes
   if (arkitMouth) return 'arkit';
   if (visemeMouth) return 'visemes';
   if (anyVowel) return 'vrm';
-  return arkit.length || arkitExpressions.length || visemes.length ? (visemes.length && !arkit.length && !arkitExpressions.length ? 'visemes' : 'arkit') : null;
+  // Nothing opens the mouth: what there is (eye shapes, a VRM's stray targets), ARKit's first.
+  if (arkit.length || arkitExpressions.length) return 'arkit';
+  return visemes.length ? 'visemes' : null;
 }
 
 /**
