@@ -143,16 +143,19 @@ function blinksOf(arkit: Target[], arkitExpressions: [string, number][], vrm: Ex
 
 /**
  * The head bone: the one named `headBone`, else a VRM's humanoid head, else findHead's. With three-vrm, a humanoid
- * bone is turned through its normalized node, which vrm.update() copies to it (the bone itself it would reset).
+ * bone is turned through its normalized node, which vrm.update() copies to it (the bone itself it would reset);
+ * where the page turned that copying off (autoUpdateHumanBones false), the bone itself, which vrm.update() then
+ * leaves alone.
  */
 function headOf(gltf: GLTF, source: string, headBone: string | null | undefined, threeVrm: ThreeVrmLike | null, file: VrmFile | null): THREE.Object3D | null {
   const humanoid = threeVrm?.humanoid;
+  const normalized = humanoid?.autoUpdateHumanBones !== false;
   if (!headBone) {
-    const own = humanoid?.getNormalizedBoneNode('head') ?? file?.head;
+    const own = (normalized ? humanoid?.getNormalizedBoneNode('head') : humanoid?.humanBones?.head?.node) ?? file?.head;
     if (own) return own;
   }
   const head = findHead(gltf.scene, source, headBone);
-  const human = Object.entries(humanoid?.humanBones ?? {}).find(([, b]) => b?.node === head)?.[0];
+  const human = normalized ? Object.entries(humanoid?.humanBones ?? {}).find(([, b]) => b?.node === head)?.[0] : undefined;
   return (human && humanoid?.getNormalizedBoneNode(human)) || head;
 }
 

@@ -99,6 +99,8 @@ export interface ThreeVrmLike {
     getNormalizedBoneNode(name: string): THREE.Object3D | null | undefined;
     /** The model's own (raw) bones by humanoid name. */
     humanBones?: Record<string, { node?: THREE.Object3D } | undefined>;
+    /** Whether vrm.update() copies the normalized bones' pose to the model's own (three-vrm's default: true). */
+    autoUpdateHumanBones?: boolean;
   };
 }
 

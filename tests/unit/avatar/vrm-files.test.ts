@@ -7,7 +7,8 @@
  */
 import { describe, expect, it } from 'vitest';
 import * as THREE from 'three';
-import type { VRM } from '@pixiv/three-vrm';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
+import { VRMLoaderPlugin, type VRM } from '@pixiv/three-vrm';
 import { GltfAvatar } from '../../../src/avatar/gltf-avatar';
 import { VISEME_VOWELS, VRM_VOWELS, VrmExpressions, readVrm } from '../../../src/avatar/vrm';
 import { ARKIT_NAMES, VISEME_NAMES } from '../../../src/avatar/names';
@@ -80,6 +81,18 @@ describe('VRM files as people make them', () => {
       const q = gltf.scene.getObjectByName('Head')!.quaternion;
       expect(2 * Math.acos(Math.min(1, Math.abs(q.w))), String(headBone)).toBeCloseTo(0.3, 5);
     }
+  });
+
+  it('with three-vrm set not to copy the normalized bones, the head turns through its own bone', async () => {
+    const loader = new GLTFLoader();
+    loader.register((parser) => new VRMLoaderPlugin(parser, { autoUpdateHumanBones: false }));
+    const gltf = await loader.parseAsync(bytes('vrm1-face.vrm'), '');
+    const avatar = GltfAvatar.bind(gltf, 'still.vrm');
+    expect(avatar.summary.headBone).toBe('Head');
+    avatar.setHeadRotation(0.3, 0, 0);
+    (gltf.userData.vrm as VRM).update(0);
+    const q = gltf.scene.getObjectByName('Head')!.quaternion;
+    expect(2 * Math.acos(Math.min(1, Math.abs(q.w)))).toBeCloseTo(0.3, 5);
   });
 
   it('says what to give it: the gltf, not three-vrm\'s VRM; a file cut short', async () => {
