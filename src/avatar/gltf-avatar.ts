@@ -17,7 +17,8 @@ export interface AvatarSummary {
   /**
    * Which output drives the face: ARKit weights when the avatar has ARKit mouth or jaw targets, else the visemes
    * when it has viseme targets (with eyeBlinkLeft / eyeBlinkRight, if it has them, still driven as blinks), else,
-   * for a VRM, its vowel expressions (aa ih ou ee oh, made from the visemes: vrm.ts) and its blink expressions.
+   * for a VRM, its vowel expressions (aa ih ou ee oh, made from the visemes: vrm.ts) and its blink expressions. A
+   * VRM is ARKit's only where its jawOpen is reached, the visemes' only where its viseme_aa is (face-binding.ts).
    */
   scheme: AvatarScheme;
   /**
@@ -26,7 +27,7 @@ export interface AvatarSummary {
    * blinkRight, or blink).
    */
   matched: string[];
-  /** The bone turned with the head pose (a VRM loaded with three-vrm: its normalized head), or null. */
+  /** The bone turned with the head pose (a VRM loaded with three-vrm: its normalized head, where three-vrm copies it), or null. */
   headBone: string | null;
 }
 
