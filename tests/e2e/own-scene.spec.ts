@@ -61,12 +61,18 @@ const collect = (page: Page): Promise<Sample[]> => page.evaluate(() => {
   return g.samples;
 });
 
-test('an avatar in the page\'s own three.js scene speaks a take frame by frame, and what the microphone hears', async ({ page, guard }) => {
-  test.setTimeout(180_000);
+/** Open the example (with `query`) and wait until it is ready; the console's warnings, collected from the start. */
+async function openExample(page: Page, query = ''): Promise<string[]> {
   const warnings: string[] = [];
   page.on('console', (m) => { if (m.type() === 'warning') warnings.push(m.text()); });
-  await page.goto('/examples/own-scene.html');
+  await page.goto(`/examples/own-scene.html${query}`);
   await expect(page.locator('#log')).toHaveText(/^ready: \d+ frames of the sample/, { timeout: 150_000 });
+  return warnings;
+}
+
+test('an avatar in the page\'s own three.js scene speaks a take frame by frame, and what the microphone hears', async ({ page, guard }) => {
+  test.setTimeout(180_000);
+  const warnings = await openExample(page);
   // The page's three.js is the project's, from its origin, and the only one: the library did not bring its own.
   const paths = guard.requests.map((u) => new URL(u).pathname);
   expect(paths).toContain('/examples/vendor/three-project/build/three.module.js');
@@ -119,10 +125,7 @@ test('an avatar in the page\'s own three.js scene speaks a take frame by frame, 
 
 test('a VRM 0.x avatar loaded with @pixiv/three-vrm in the page\'s own scene speaks through its expressions and turns its head', async ({ page, guard }) => {
   test.setTimeout(180_000);
-  const warnings: string[] = [];
-  page.on('console', (m) => { if (m.type() === 'warning') warnings.push(m.text()); });
-  await page.goto('/examples/own-scene.html?avatar=/examples/avatars/vrm0-face.vrm');
-  await expect(page.locator('#log')).toHaveText(/^ready: \d+ frames of the sample/, { timeout: 150_000 });
+  const warnings = await openExample(page, '?avatar=/examples/avatars/vrm0-face.vrm');
   expect(guard.requests.map((u) => new URL(u).pathname)).toContain('/examples/vendor/three-vrm/three-vrm.module.js');
   const bound = await page.evaluate(() => {
     const { state } = (globalThis as any).ownSceneExample;
