@@ -6,6 +6,7 @@ import { addAvatarFace } from './helpers/avatar';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { VRMAnimationLoaderPlugin, type VRMAnimation } from '@pixiv/three-vrm-animation';
 import { GltfAvatar } from '../../src/avatar/gltf-avatar';
+import { editGlbJson } from '../../src/avatar/gltf-nodes';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
 
 /**
@@ -178,17 +179,7 @@ function renamedAvatar(rename: (name: string) => string): string {
 /** A test avatar (base64) with its glTF JSON changed by `edit`. */
 function editedAvatar(file: string, edit: (gltf: any) => void): string {
   const b = readFileSync(resolve(AVATARS, file));
-  const jsonLength = b.readUInt32LE(12);
-  const gltf = JSON.parse(b.subarray(20, 20 + jsonLength).toString());
-  edit(gltf);
-  let text = JSON.stringify(gltf);
-  while (text.length % 4) text += ' ';
-  const json = Buffer.from(text);
-  const out = Buffer.concat([b.subarray(0, 12), Buffer.alloc(8), json, b.subarray(20 + jsonLength)]);
-  out.writeUInt32LE(out.length, 8);
-  out.writeUInt32LE(json.length, 12);
-  out.write('JSON', 16);
-  return out.toString('base64');
+  return Buffer.from(editGlbJson(b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer, edit)).toString('base64');
 }
 
 test('an avatar file that is not glTF, or has neither naming scheme, gives a clear error; prefixed names match', async ({ page, guard }) => {

@@ -4,17 +4,15 @@
  * as the avatar driven live by GltfAvatar (vowels from the visemes, the head from the pose).
  */
 import { beforeAll, describe, expect, it } from 'vitest';
-import { readFileSync } from 'node:fs';
-import { resolve } from 'node:path';
 import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/addons/loaders/GLTFLoader.js';
-import { VRMLoaderPlugin, VRMUtils, type VRM } from '@pixiv/three-vrm';
+import { VRMUtils, type VRM } from '@pixiv/three-vrm';
 import { VRMAnimationLoaderPlugin, createVRMAnimationClip, type VRMAnimation } from '@pixiv/three-vrm-animation';
 import { GltfAvatar } from '../../../src/avatar/gltf-avatar';
 import { vrmAnimation } from '../../../src/avatar/vrm-animation';
 import { ARKIT_NAMES, VISEME_NAMES } from '../../../src/avatar/names';
 import type { Animation } from '../../../src/engine/frames';
-import { ROOT } from '../helpers/exported';
+import { load } from '../helpers/vrm';
 import { installFileReader } from '../helpers/file-reader';
 
 beforeAll(() => installFileReader()); // GLTFExporter's, which Node lacks
@@ -32,15 +30,12 @@ function take(): Animation {
   return { frames: F, fps: FPS, pose, blendshapes } as unknown as Animation;
 }
 
-async function load(bytes: ArrayBuffer, plugin: (parser: never) => unknown): Promise<GLTF> {
+/** A .vrma read by three-vrm-animation's loader plugin. */
+async function readVrma(bytes: ArrayBuffer): Promise<VRMAnimation> {
   const loader = new GLTFLoader();
-  loader.register(plugin as never);
-  return loader.parseAsync(bytes, '');
+  loader.register((parser) => new VRMAnimationLoaderPlugin(parser));
+  return (await loader.parseAsync(bytes, '')).userData.vrmAnimations[0] as VRMAnimation;
 }
-const file = (name: string) => {
-  const b = readFileSync(resolve(ROOT, 'examples/avatars', name));
-  return b.buffer.slice(b.byteOffset, b.byteOffset + b.byteLength) as ArrayBuffer;
-};
 /** Every morph target's influence by name, and the model's head bone's rotation relative to the avatar's root. */
 function face(gltf: GLTF) {
   const morphs: Record<string, number> = {};
@@ -55,8 +50,7 @@ function face(gltf: GLTF) {
 
 describe('vrmAnimation', () => {
   it('writes a VRM Animation that three-vrm-animation reads: a humanoid, the five vowels, one clip as long as the take', async () => {
-    const gltf = await load(await vrmAnimation(take()), (parser) => new VRMAnimationLoaderPlugin(parser));
-    const [animation] = gltf.userData.vrmAnimations as VRMAnimation[];
+    const animation = await readVrma(await vrmAnimation(take()));
     expect([...animation.humanoidTracks.rotation.keys()]).toEqual(['head']);
     expect([...animation.expressionTracks.preset.keys()]).toEqual(['aa', 'ih', 'ou', 'ee', 'oh']);
     expect(animation.duration).toBeCloseTo((F - 1) / FPS, 6);
@@ -65,9 +59,9 @@ describe('vrmAnimation', () => {
 
   it.each(['vrm1-face.vrm', 'vrm0-face.vrm'])('played on %s, gives the face the live driver gives at each frame', async (name) => {
     const t = take();
-    const vrma = (await load(await vrmAnimation(t), (parser) => new VRMAnimationLoaderPlugin(parser))).userData.vrmAnimations[0] as VRMAnimation;
-    const played = await load(file(name), (parser) => new VRMLoaderPlugin(parser));
-    const driven = await load(file(name), (parser) => new VRMLoaderPlugin(parser));
+    const vrma = await readVrma(await vrmAnimation(t));
+    const played = await load(name, true);
+    const driven = await load(name, true);
     const [vrmPlayed, vrmDriven] = [played.userData.vrm as VRM, driven.userData.vrm as VRM];
     VRMUtils.rotateVRM0(vrmPlayed);
     VRMUtils.rotateVRM0(vrmDriven);
