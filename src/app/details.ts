@@ -8,7 +8,7 @@ import type { Backend, TalkingFaceEngine } from '../engine/engine';
 import { tell, ui } from './controls';
 import { isolated } from './names';
 import { fmaModule, simdUnavailable } from '../attention/simd-kernel';
-import { SHORT_CLIP_SECONDS } from '../player/player';
+import { SHORT_CLIP_SECONDS } from '../player/audio-notes';
 import { levels, SILENT_PEAK } from '../audio/decode';
 import type { Take } from './take-view';
 

@@ -1,7 +1,6 @@
 /**
- * The demo shell: the only code that touches the page's DOM. It loads the face and the model; animates
- * an audio file the visitor opens or drops, a sample clip, or the microphone live while they speak; and plays
- * the take back with the face in sync (play, pause, scrub, loop) through the shared Player.
+ * The demo shell: the only code that touches the page's DOM. It loads the face and the model; animates an audio file the
+ * visitor opens or drops, a sample clip, or the microphone live; and plays the take back in sync through the shared Player.
  */
 import { loadTemplate } from '../template/face-template';
 import { FaceView } from '../render/face-view';
@@ -9,7 +8,8 @@ import { detectWebGPU } from '../gpu/capabilities';
 import { TalkingFaceEngine, type Backend } from '../engine/engine';
 import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
 import { decodeAudio } from '../audio/decode';
-import { Player, audioNotes } from '../player/player';
+import { Player } from '../player/player';
+import { audioNotes } from '../player/audio-notes';
 import { TakeView, animateAudio, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
 import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';

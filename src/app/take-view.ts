@@ -11,7 +11,7 @@ import { Painter, type PaintMode } from './paint';
 import { clipLipError, onTruthFace, type Truth } from './samples';
 import { announce, headScaleText, showLegend, showStatus, tell, ui, type HeadChange } from './controls';
 import { isolated } from './names';
-import { audioNotes } from '../player/player';
+import { audioNotes } from '../player/audio-notes';
 import { raiseIfQuiet } from '../audio/decode';
 
 export interface Take {

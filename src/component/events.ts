@@ -3,7 +3,7 @@ import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/en
 import type { StreamSession } from '../engine/stream';
 import type { AvatarSummary } from '../avatar/gltf-avatar';
 import { frameWeights, type FrameWeights } from '../avatar/weights';
-import { SHORT_CLIP_SECONDS } from '../player/player';
+import { SHORT_CLIP_SECONDS } from '../player/audio-notes';
 
 export interface ReadyDetail {
   backend: Backend;
@@ -21,11 +21,12 @@ export interface ReadyDetail {
 
 /** With an avatar or the `blendshapes` attribute, also the frame's ARKit weights, visemes and head rotation. */
 export interface FrameDetail extends Partial<FrameWeights> {
-  /** Frame index in the current take (offline) or since the microphone started (live). */
+  /** Frame index in the current take (offline), since the microphone started (live), or since the stream began (stream). */
   frame: number;
   /** Seconds into the audio. */
   time: number;
-  mode: 'playback' | 'live';
+  /** 'stream': speech written to speakStream(), one event per frame shown. */
+  mode: 'playback' | 'live' | 'stream';
   backend: Backend;
   /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
   inferenceMs?: number;
@@ -35,6 +36,11 @@ export interface FrameDetail extends Partial<FrameWeights> {
    * time: the face shows fewer frames than the voice has, and a page may say so or lighten its own work.
    */
   skippedFrames?: number;
+  /**
+   * Stream: frames so far whose sound played before they were computed (0 while the device keeps up with the
+   * stream's delay). Above 0 the face lags its voice; a longer `delayMs` would help.
+   */
+  lateFrames?: number;
   /** Offline: seconds of audio per second of compute. */
   realTimeFactor?: number;
 }
@@ -78,6 +84,14 @@ export function liveFrameDetail(engine: TalkingFaceEngine, first: number, frames
     frame: first + last, time: (first + last) / engine.fps, mode: 'live', backend: engine.backend,
     latencyMs: stream?.latency.lastMs, skippedFrames: stream?.skippedFrames ?? 0,
     ...(frames.blendshapes && frameWeights(frames.blendshapes, last)),
+  };
+}
+
+/** Frame `at` of `frames`, the stream's frame `frame`, shown as its sound plays (speakStream). */
+export function streamFrameDetail(engine: TalkingFaceEngine, frame: number, frames: Frames, at: number, lateFrames: number): FrameDetail {
+  return {
+    frame, time: frame / engine.fps, mode: 'stream', backend: engine.backend, lateFrames,
+    ...(frames.blendshapes && frameWeights(frames.blendshapes, at)),
   };
 }
 

@@ -5,7 +5,7 @@
 import type { Animation, TalkingFaceEngine } from '../engine/engine';
 import { decodeAudio, raiseIfQuiet, type DecodedAudio } from '../audio/decode';
 import { audioInput, frameOptions } from './attributes';
-import { audioNotes, SHORT_CLIP_SECONDS } from '../player/player';
+import { audioNotes, SHORT_CLIP_SECONDS } from '../player/audio-notes';
 import type { TalkingFaceErrorDetail } from './events';
 
 export interface ElementTake {

@@ -16,11 +16,13 @@ import { avatarAttributes, backendAttribute, frameOptions, isOn, reflect } from 
 import { makeTake, TakeError, type ElementTake } from './take';
 import { shadowParts, type StatusLine } from './parts';
 import { ElementStage } from './stage';
-import { openMicrophone } from '../audio/capture';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { liveFrameDetail, playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
+import { SpeechStream, type SpeechStreamOptions } from './speech-stream';
+import { listenLive } from './microphone';
+import type { WorkHost } from './work-host';
+import { playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
 
@@ -162,6 +164,31 @@ export class TalkingFaceElement extends ElementBase {
     await player.play(0);
   }
 
+  /**
+   * Speech that arrives in pieces (a streaming text-to-speech, a voice agent): write() its PCM as it comes, end() after
+   * the last piece; each piece is animated and played, the face in sync, a short delay after it arrives. docs/embedding.md.
+   */
+  speakStream(options: SpeechStreamOptions): SpeechStream {
+    const { gen, signal } = this.begin();
+    const work = this.work;
+    try {
+      return new SpeechStream(options, this.host(gen, signal), (animation, buffer) => {
+        if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
+        this.animation = animation;
+        this.stage.player?.load(animation, buffer); // for recordVideo()
+      });
+    } catch (e) {
+      throw this.fail('audio', (e as Error).message);
+    }
+  }
+
+  /** What work of generation `gen` (stopped by `signal`) is lent: the model, the player, the status line, the events. */
+  private host(gen: number, signal: AbortSignal): WorkHost {
+    return { signal, element: this, engine: unlessAborted(this.load(), signal), player: () => this.stage.player, settled: () => this.stage.settled(),
+      current: () => gen === this.generation, status: (text) => this.status.set(text), fail: (stage, message) => this.fail(stage, message),
+      playing: (text) => this.status.set((this.playingStatus = text)), dispatch: (event) => this.dispatchEvent(event) };
+  }
+
   /** Stop what this element does and claim the next generation for new work, which `signal` cancels. */
   private begin(): { gen: number; signal: AbortSignal } {
     this.halt(false);
@@ -172,38 +199,8 @@ export class TalkingFaceElement extends ElementBase {
   /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
   async startMicrophone(): Promise<void> {
     const { gen, signal } = this.begin();
-    const engine = await unlessAborted(this.load(), signal);
-    if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded: the microphone stays closed
-    let media: MediaStream;
-    try {
-      media = await openMicrophone();
-    } catch (e) {
-      if (gen !== this.generation) return; // stopped (or removed) while the browser asked: not a failure
-      throw this.fail('microphone', (e as Error).message);
-    }
-    if (gen !== this.generation) return void media.getTracks().forEach((t) => t.stop()); // stopped while the browser asked
-    let live: LiveSession;
-    try {
-      live = await engine.listen(media, (first: number, frames: Frames) => {
-        if (gen !== this.generation || !this.stage.player) return;
-        this.stage.player.showLive(frames, engine.fps);
-        this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: liveFrameDetail(engine, first, frames, this.liveSession?.stream) }));
-      }, { onError: (e) => gen === this.generation && this.lost('inference', `live animation stopped: ${e.message}`), keepAudio: false,
-        onInterrupted: (e) => gen === this.generation && this.lost('microphone', `listening stopped: ${e.message}`),
-        ...frameOptions(this) });
-    } catch (e) {
-      for (const t of media.getTracks()) t.stop();
-      if (gen !== this.generation) return; // stopped meanwhile: not a failure
-      throw this.fail('microphone', `the microphone could not be captured: ${(e as Error).message}`);
-    }
-    if (gen !== this.generation) { // stopped while the capture started
-      void live.stop();
-      for (const t of media.getTracks()) t.stop();
-      return;
-    }
-    this.liveSession = live;
-    this.work = null;
-    this.status.set(`Listening (look-ahead ${Math.round(this.liveSession.stream.lookAheadMs)} ms, ${engine.backend})…`);
+    const live = await listenLive(this.host(gen, signal), (stage, message) => this.lost(stage, message));
+    if (live) [this.liveSession, this.work] = [live, null];
   }
 
   /**
@@ -226,9 +223,9 @@ export class TalkingFaceElement extends ElementBase {
   private halt(say: boolean): void {
     this.generation++;
     const cancelled = this.work;
+    const wasPlaying = this.stage.player?.isPlaying ?? false; // (before the abort, which stops a stream's sound)
     this.work = null;
     cancelled?.abort(); // an animation under way stops at its next chunk
-    const wasPlaying = this.stage.player?.isPlaying ?? false;
     this.stage.player?.stop();
     if (wasPlaying || this.liveSession) {
       (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest

@@ -5,7 +5,6 @@
  */
 import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
-import { SILENT_PEAK, levels } from '../audio/decode';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
@@ -22,40 +21,6 @@ export interface PlayerView {
   setSpeaking?(on: boolean): void;
   /** The model's face at rest, for a view with idle life. */
   setRestFace?(rest: Float32Array): void;
-}
-
-/** Longer clips get a note: they take a while, and their take's memory grows with them (40-50 MB a minute in the demo). */
-export const LONG_CLIP_SECONDS = 120;
-/** Shorter clips get a note, and no speed figure (a few frames measure start-up, not speed). */
-export const SHORT_CLIP_SECONDS = 0.5;
-
-/** What audioNotes knows besides the samples. */
-export interface NoteOptions {
-  /** Whether speech was found (the engine's hasSpeech, once animated; default true). */
-  speech?: boolean;
-  /** The gain a quiet clip was raised by for the model (raiseIfQuiet; default 0). */
-  raisedDb?: number;
-  /** Notes while it is being animated: a long clip says it can be cancelled (default false). */
-  animating?: boolean;
-  /** How long the file's header says it is, where it holds less (DecodedAudio's source.statedSeconds; default null). */
-  statedSeconds?: number | null;
-}
-
-/**
- * Notes for a person about a clip's audio, the most important first: the file cut short, silent, no speech in it,
- * raised because it was quiet, clipped, very short; long (while animating). Empty when there is nothing to say.
- */
-export function audioNotes(samples: Float32Array, seconds: number, { speech = true, raisedDb = 0, animating = false, statedSeconds = null }: NoteOptions = {}): string[] {
-  const lv = levels(samples);
-  const notes: string[] = [];
-  if (statedSeconds !== null && statedSeconds > seconds) notes.push(`the file ends early: it holds ${seconds.toFixed(1)} s of the ${statedSeconds.toFixed(1)} s its header states (cut short while copying or recording?)`);
-  if (lv.peak < SILENT_PEAK) notes.push('the audio is silent, so the mouth stays closed');
-  else if (!speech) notes.push('no speech was found in it (noise, music or a tone?), so the mouth stays at rest');
-  if (lv.peak >= SILENT_PEAK && raisedDb > 0) notes.push(`very quiet (peak ${(20 * Math.log10(lv.peak)).toFixed(0)} dBFS): raised by ${raisedDb.toFixed(0)} dB to animate it`);
-  if (lv.clipped > 0.01) notes.push(`${(100 * lv.clipped).toFixed(1)}% of the samples are clipped (distorted); the motion may be less accurate`);
-  if (seconds < SHORT_CLIP_SECONDS) notes.push(`a very short clip (${seconds.toFixed(2)} s): too short to show much`);
-  if (animating && seconds > LONG_CLIP_SECONDS) notes.push(`a long clip (${(seconds / 60).toFixed(1)} min): it takes a while, and the page's memory grows with its length; Cancel stops it`);
-  return notes;
 }
 
 export interface PlayerOptions {
@@ -104,6 +69,7 @@ export class Player {
   private liveQueue: { frames: Frames; f: number; due: number }[] = []; // live frames to show, each at its time
   private liveTick = 0; // the animation frame that shows them (0: none asked)
   private forgetGesture: () => void = () => undefined; // removes the listeners awaitGesture left on the document
+  private streaming: (() => void) | null = null; // stops the streamed speech playing (player/stream-playback.ts)
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
   constructor(private readonly view: PlayerView, public unitsPerMm: number, private readonly options: PlayerOptions = {}) {}
@@ -130,7 +96,7 @@ export class Player {
   }
 
   get isPlaying(): boolean {
-    return this.playing !== null;
+    return this.playing !== null || this.streaming !== null;
   }
 
   /** Show frame `frame` of the take (clamped to it). */
@@ -178,15 +144,20 @@ export class Player {
       const shown = this.liveQueue.splice(0, n);
       for (const q of shown) this.countSpeech(q.frames, q.f);
       const { frames, f } = shown[n - 1];
-      const n3 = frames.unposed.length / frames.count;
-      this.view.setTongue?.(frames.tongue[f] ?? 0);
-      this.view.setVertices(frames.unposed.subarray(f * n3, (f + 1) * n3));
-      this.view.setSpeaking?.(this.liveQuiet < LIVE_REST_FRAMES);
-      if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, f);
-      this.pose(frames.pose.subarray(f * 6, f * 6 + 6));
+      this.showFrame(frames, f, this.liveQuiet < LIVE_REST_FRAMES);
     }
     if (this.liveQueue.length) this.liveTick = requestAnimationFrame(this.showDue);
   };
+
+  /** Show frame `f` of streamed `frames`; `speaking` false: the face goes back to rest (and its life with it). */
+  showFrame(frames: Frames, f: number, speaking: boolean): void {
+    const n3 = frames.unposed.length / frames.count;
+    this.view.setTongue?.(frames.tongue[f] ?? 0);
+    this.view.setVertices(frames.unposed.subarray(f * n3, (f + 1) * n3));
+    this.view.setSpeaking?.(speaking);
+    if (frames.blendshapes) this.view.setBlendshapes?.(frames.blendshapes, f);
+    this.pose(frames.pose.subarray(f * 6, f * 6 + 6));
+  }
 
   private countSpeech(frames: Frames, f: number): void {
     this.liveQuiet = frames.speech[f] > SPEECH_PROBABILITY ? 0 : this.liveQuiet + 1;
@@ -213,8 +184,7 @@ export class Player {
     return new Promise<void>((resolve) => {
       const source = context.createBufferSource();
       source.buffer = this.buffer;
-      source.connect(context.destination);
-      if (this.tapNode) source.connect(this.tapNode);
+      this.output(source);
       const startedAt = context.currentTime + 0.05;
       const playing: Playing = { source, startedAt, fromFrame: start, finish: resolve };
       source.onended = () => {
@@ -243,14 +213,44 @@ export class Player {
         requestAnimationFrame(tick);
       };
       requestAnimationFrame(tick);
-      void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
-        if (this.playing === playing && context.state === 'suspended') this.awaitGesture(context, playing);
-      });
+      this.watchAutoplay(resumed, () => this.playing === playing);
+    });
+  }
+
+  /**
+   * Streamed speech begins (player/stream-playback.ts): what played stops, and `stop` is what stop() calls until
+   * streamDone(). Its sound goes out through output().
+   */
+  beginStream(stop: () => void): AudioContext {
+    this.stop();
+    this.streaming = stop;
+    const context = (this.context ??= new AudioContext());
+    // Deliberate: resume() rejects only when the context is closed, and then start() throws with the reason.
+    this.watchAutoplay(context.resume().catch(() => undefined), () => this.streaming === stop);
+    return context;
+  }
+
+  /** The streamed speech `stop` is over (played out, or stopped). */
+  streamDone(stop: () => void): void {
+    if (this.streaming === stop) this.streaming = null;
+  }
+
+  /** Where sound that plays goes: the speakers, and the tap while one is open (recordVideo). */
+  output(node: AudioNode): void {
+    node.connect(this.context!.destination);
+    if (this.tapNode) node.connect(this.tapNode);
+  }
+
+  /** Once `resumed` settles or AUTOPLAY_WAIT_MS pass: a context still suspended waits for a gesture, while `current()`. */
+  private watchAutoplay(resumed: Promise<unknown>, current: () => boolean): void {
+    const context = this.context!;
+    void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
+      if (current() && context.state === 'suspended') this.awaitGesture(context, current);
     });
   }
 
   /** The sound is held back until a gesture: resume the context on the next one (the face follows its clock). */
-  private awaitGesture(context: AudioContext, playing: Playing): void {
+  private awaitGesture(context: AudioContext, current: () => boolean): void {
     this.options.onBlocked?.();
     this.forgetGesture();
     const forget = (this.forgetGesture = () => {
@@ -260,7 +260,7 @@ export class Player {
     const resume = () => {
       void context.resume().then(() => {
         forget();
-        if (this.playing === playing) this.options.onUnblocked?.();
+        if (current()) this.options.onUnblocked?.();
       }, forget); // rejects only on a closed context (the player disposed): nothing left to play
     };
     for (const g of GESTURES) document.addEventListener(g, resume, true);
@@ -292,6 +292,9 @@ export class Player {
     this.liveQueue = [];
     if (this.liveTick) cancelAnimationFrame(this.liveTick);
     this.liveTick = 0;
+    const streaming = this.streaming;
+    this.streaming = null;
+    streaming?.();
     const p = this.playing;
     if (!p) return;
     this.playing = null;

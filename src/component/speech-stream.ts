@@ -1,0 +1,204 @@
+/**
+ * <talking-face>'s speakStream(): speech that arrives in pieces (a streaming text-to-speech, a voice agent's socket)
+ * animated and played as it comes, the face in sync with the sound. Each piece is played a fixed delay after the
+ * first arrived (player/stream-playback.ts) and pushed, at the model's rate, into the engine's stream, whose frames
+ * are ready before their sound plays. docs/embedding.md, "Streamed speech".
+ */
+import type { TalkingFaceEngine } from '../engine/engine';
+import { placeFrames, type Animation, type Frames } from '../engine/frames';
+import type { StreamSession } from '../engine/stream';
+import { StreamResampler } from '../audio/capture';
+import { checkedStreamRate, PcmReader, type PcmChunk } from '../audio/pcm';
+import type { Player } from '../player/player';
+import { StreamPlayback } from '../player/stream-playback';
+import { frameOptions } from './attributes';
+import { streamFrameDetail, type FrameDetail } from './events';
+import type { WorkHost } from './work-host';
+
+/** What the delay holds besides the model's look-ahead and the first piece: time to compute the frames (s). */
+export const STREAM_MARGIN_SECONDS = 0.15;
+/**
+ * The first piece counts for at most this long (s): pieces that come at the pace of speech each wait for the next (the
+ * look-ahead reads into it), but a long first piece is a burst, and the delay grows by itself where frames come late.
+ */
+export const FIRST_PIECE_SECONDS = 0.25;
+
+export interface SpeechStreamOptions {
+  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM). */
+  sampleRate: number;
+  /**
+   * How long after the first piece arrives its sound starts (ms). Default: the model's look-ahead, the first piece's
+   * length (at most 0.25 s) and 150 ms to compute in: about 0.36 s for pieces of 0.1 s. Where frames come late all the
+   * same (a slow device, a busy page) it grows by itself, at the cost of a pause in the sound.
+   */
+  delayMs?: number;
+}
+
+export class SpeechStream {
+  /** Resolves once everything written has played (after end()), or on stop(); rejects if the stream failed. */
+  readonly done: Promise<void>;
+  readonly sampleRate: number;
+  private readonly reader = new PcmReader('SpeechStream.write');
+  private pieces: Float32Array[] = [];
+  private pending: Float32Array[] = []; // written before the model and the face were there
+  private written = 0; // samples written, at sampleRate
+  private pushed = 0; // samples pushed into the engine's stream, at the model's rate
+  private delay = 0; // seconds from a piece's arrival to its sound
+  private ended = false;
+  private closed = false;
+  private session: StreamSession | null = null;
+  private resampler: StreamResampler | null = null;
+  private playback: StreamPlayback | null = null;
+  private started: { engine: TalkingFaceEngine; player: Player } | null = null;
+  private chunks: { first: number; frames: Frames }[] = [];
+  private settle: { resolve: () => void; reject: (e: Error) => void } = { resolve: () => undefined, reject: () => undefined };
+
+  /** `keep`: called once it has played out, with the whole take (the element keeps it for currentAnimation and recordVideo). */
+  constructor(options: SpeechStreamOptions, private readonly host: WorkHost, private readonly keep: (animation: Animation, buffer: AudioBuffer) => void) {
+    this.sampleRate = checkedStreamRate(options?.sampleRate, 'speakStream');
+    if (options.delayMs !== undefined && !(options.delayMs >= 0 && options.delayMs <= 10000)) {
+      throw new RangeError(`speakStream: delayMs must be from 0 to 10000 ms; it was ${options.delayMs}`);
+    }
+    this.done = new Promise((resolve, reject) => (this.settle = { resolve, reject }));
+    this.done.catch(() => undefined); // deliberate: the failure is also an `error` event; a page need not await done
+    host.signal.addEventListener('abort', () => this.close(), { once: true });
+    void this.start(options.delayMs);
+  }
+
+  /** Seconds of speech written so far. */
+  get seconds(): number {
+    return this.written / this.sampleRate;
+  }
+
+  /** How long a piece that starts the sound waits between its arrival and its sound (ms; it grows where frames came late); null before the first piece. */
+  get delayMs(): number | null {
+    return this.playback ? this.playback.delay * 1000 : null;
+  }
+
+  /**
+   * Frames whose sound played before they were computed (the device behind the delay), and the times the sound paused
+   * (the pieces ran dry, or the delay grew because frames came late).
+   */
+  get late(): { frames: number; pauses: number } {
+    return { frames: this.playback?.lateFrames ?? 0, pauses: this.playback?.pauses ?? 0 };
+  }
+
+  /**
+   * The next piece: mono samples at `sampleRate` (a Float32Array in -1..1, an Int16Array, or the bytes of 16-bit
+   * little-endian PCM). False when the stream is over (stopped, ended or failed) and the piece was dropped; throws a
+   * TypeError or RangeError for a piece that is not audio.
+   */
+  write(chunk: PcmChunk): boolean {
+    if (this.closed || this.ended) return false;
+    const samples = this.reader.read(chunk);
+    if (samples.length === 0) return true;
+    this.pieces.push(samples);
+    this.written += samples.length;
+    if (this.started) this.feed(samples);
+    else this.pending.push(samples);
+    return true;
+  }
+
+  /** No more pieces: `done` resolves once the last has played. */
+  end(): void {
+    if (this.closed || this.ended) return;
+    this.ended = true;
+    if (this.started) void this.finish();
+  }
+
+  private async start(delayMs: number | undefined): Promise<void> {
+    let engine: TalkingFaceEngine | null, player: Player | null;
+    try {
+      engine = await this.host.engine;
+      player = engine && (await this.host.settled());
+    } catch (e) {
+      return this.fail(e as Error); // the model could not be loaded: load() has said so
+    }
+    if (this.closed || !this.host.current() || !engine) return this.close();
+    if (!player) return this.fail(this.host.fail('avatar', 'there is no face to show the speech on (is the element in the page?)'));
+    this.started = { engine, player };
+    this.session = engine.createStream((first, frames) => this.frames(first, frames), frameOptions(this.host.element));
+    this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
+    const lookAhead = this.session.lookAheadMs / 1000;
+    const first = Math.min(FIRST_PIECE_SECONDS, this.pending.length ? this.pending[0].length / this.sampleRate : 0.1);
+    this.delay = delayMs !== undefined ? delayMs / 1000 : lookAhead + first + STREAM_MARGIN_SECONDS;
+    for (const p of this.pending.splice(0)) this.feed(p);
+    if (this.ended) void this.finish();
+  }
+
+  private feed(samples: Float32Array): void {
+    const { engine, player } = this.started!;
+    if (!this.playback) {
+      this.playback = new StreamPlayback(player, this.sampleRate, engine.fps, this.delay, {
+        onFrame: (frame, frames, at) => this.host.dispatch(new CustomEvent<FrameDetail>('frame',
+          { detail: streamFrameDetail(engine, frame, frames, at, this.playback?.lateFrames ?? 0) })),
+      });
+      void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with the player
+
+      this.host.playing(`Playing streamed speech (${Math.round(this.delay * 1000)} ms behind it, ${engine.backend}).`);
+    }
+    this.playback.write(samples);
+    this.push(this.resampler!.push(samples)).catch((e: Error) => this.broken(e));
+  }
+
+  private push(samples: Float32Array): Promise<void> {
+    this.pushed += samples.length;
+    return this.session!.push(samples);
+  }
+
+  private frames(first: number, frames: Frames): void {
+    if (this.closed) return;
+    this.chunks.push({ first, frames });
+    this.playback?.frames(first, frames);
+  }
+
+  /** The last piece is in: the resampler's tail and the stream's last frames, then the sound plays out. */
+  private async finish(): Promise<void> {
+    try {
+      // The resampler holds back half its kernel: zeros after the end bring the last samples out, and no more.
+      const tail = this.resampler!.push(new Float32Array(Math.ceil(this.resampler!.delaySeconds * this.sampleRate) + 2));
+      const model = this.started!.engine.manifest.audio.sample_rate;
+      const missing = Math.round((this.written / this.sampleRate) * model) - this.pushed;
+      if (missing > 0) await this.push(tail.subarray(0, missing));
+      await this.session!.end();
+    } catch (e) {
+      return this.broken(e as Error);
+    }
+    if (this.closed) return;
+    if (!this.playback) return this.close(); // nothing was written
+    this.playback.end();
+    await this.playback.done;
+    if (!this.playback.playedOut || !this.host.current() || this.chunks.length === 0) return this.close();
+    const total = this.chunks.at(-1)!.first + this.chunks.at(-1)!.frames.count;
+    const buffer = new AudioBuffer({ length: this.written, numberOfChannels: 1, sampleRate: this.sampleRate });
+    let at = 0;
+    for (const p of this.pieces) {
+      buffer.getChannelData(0).set(p, at);
+      at += p.length;
+    }
+    this.pieces = [];
+    this.keep(placeFrames(this.chunks, total, this.started!.engine.fps), buffer);
+    this.host.status(`Played streamed speech (${buffer.duration.toFixed(1)} s${this.playback.lateFrames ? `; ${this.playback.lateFrames} frames came late` : ''}).`);
+    this.host.dispatch(new CustomEvent('ended'));
+    this.close();
+  }
+
+  private broken(e: Error): void {
+    if (this.closed || !this.host.current()) return;
+    this.fail(this.host.fail('inference', `the streamed speech could not be animated: ${e.message}`));
+  }
+
+  private fail(e: Error): void {
+    this.close();
+    this.settle.reject(e);
+  }
+
+  /** Over: stopped, played out or failed. The sound stops (if it still plays) and `done` settles. */
+  private close(): void {
+    if (this.closed) return;
+    this.closed = true;
+    this.playback?.stop();
+    this.pending = [];
+    this.settle.resolve();
+  }
+}

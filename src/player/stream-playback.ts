@@ -1,0 +1,184 @@
+/**
+ * Streamed speech played with the face in sync. Pieces of sound are scheduled on the player's audio clock in spans
+ * (StreamTimeline): a span starts `delay` seconds after its first piece arrived, and not before the frame of its first
+ * sound has been computed; the pieces after it play back to back. Each animation frame shows the frame whose sound
+ * is playing. Where the engine falls behind all the same (frames computed after their sound began: a slow device, a
+ * busy page), the delay grows by how late they came and the next piece starts a new span that much later: the sound
+ * pauses once, and the face is in sync again.
+ */
+import type { Frames } from '../engine/frames';
+import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
+import type { Player } from './player';
+import { SCHEDULE_MARGIN, StreamTimeline } from './stream-timeline';
+
+/** A pause in the sound longer than this (s) brings the face back to rest until the sound goes on. */
+export const REST_AFTER_SECONDS = 0.25;
+/** Frames this late (s) or less do not move the delay (a display shows them a frame later at worst). */
+export const LATE_TOLERANCE = 0.04;
+/** Where the delay grows, it grows this much (s) beyond what the late frames needed, so that it need not grow again soon. */
+export const GROW_MARGIN = 0.1;
+/** The delay never grows beyond this (s). */
+export const MAX_DELAY = 3;
+
+export interface StreamPlaybackOptions {
+  /** Called for each frame shown: the stream's frame `frame`, which is `frames`' frame `at`. */
+  onFrame?: (frame: number, frames: Frames, at: number) => void;
+}
+
+export class StreamPlayback {
+  /** Resolves when every piece written has played and its frames shown after end(), or when stopped. */
+  readonly done: Promise<void>;
+  /** Frames shown after their sound had begun (the newest computed frame shown in their place). */
+  lateFrames = 0;
+  /** Times the sound paused: the stream ran dry, or the delay grew. */
+  pauses = 0;
+  /** Set when it ended by playing everything out (not by stop()). */
+  playedOut = false;
+  private readonly timeline: StreamTimeline;
+  private readonly context: AudioContext;
+  private readonly sources = new Set<AudioBufferSourceNode>();
+  private waiting: Float32Array[] = []; // pieces of a span that has not started
+  private waitingSince = 0; // clock time its first piece arrived
+  private spanDelay = 0; // the span playing: seconds from its first piece's arrival to its sound
+  private needed = 0; // the delay the frames of the span playing needed (0: none came late)
+  private chunks: { first: number; frames: Frames }[] = [];
+  private computed = 0; // frames [0, computed) have come
+  private ended = false;
+  private over = false;
+  private tick = 0;
+  private shown = -1;
+  private resting = false; // the sound has paused long enough for the face to rest
+  private finish: () => void = () => undefined;
+  private readonly stopper = () => this.close();
+
+  /** `rate`: the pieces' sample rate; `fps`: the frames'; `delay`: seconds from a span's first piece arriving to its sound. */
+  constructor(private readonly player: Player, readonly rate: number, private readonly fps: number, public delay: number,
+    private readonly options: StreamPlaybackOptions = {}) {
+    this.timeline = new StreamTimeline(rate);
+    this.done = new Promise((resolve) => (this.finish = resolve));
+    this.context = player.beginStream(this.stopper);
+    this.tick = requestAnimationFrame(this.draw);
+  }
+
+  /** The next piece of sound (mono, at `rate`): it plays after the pieces before it. */
+  write(samples: Float32Array): void {
+    if (this.over || this.ended || samples.length === 0) return;
+    const now = this.context.currentTime;
+    const follows = this.timeline.follows(now);
+    if (this.needed > this.delay) this.delay = Math.min(MAX_DELAY, this.needed); // and this piece starts a new span
+    else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
+    this.needed = 0;
+    if (this.waiting.length === 0) {
+      this.waitingSince = now;
+      if (this.timeline.samples > 0) this.pauses++;
+    }
+    this.waiting.push(samples);
+    this.release();
+  }
+
+  /** Frames `first` .. computed by the engine from the pieces written (in order, from frame 0). */
+  frames(first: number, frames: Frames): void {
+    if (this.over || frames.count === 0) return;
+    this.chunks.push({ first, frames });
+    this.computed = first + frames.count;
+    const due = this.timeline.timeOf(Math.round((first / this.fps) * this.rate));
+    const late = due === null ? 0 : this.context.currentTime - due;
+    if (late > LATE_TOLERANCE) this.needed = Math.max(this.needed, this.spanDelay + late + GROW_MARGIN);
+    this.release();
+  }
+
+  /** No more pieces: once the last has played (and its frames come), the playback is over. */
+  end(): void {
+    this.ended = true;
+  }
+
+  /** Stop the sound now; `done` resolves. */
+  stop(): void {
+    if (!this.over) this.player.stop(); // calls close(), as the player's own stop() does (the element's stop())
+  }
+
+  private schedule(samples: Float32Array, at: number): void {
+    const buffer = new AudioBuffer({ length: samples.length, numberOfChannels: 1, sampleRate: this.rate });
+    buffer.getChannelData(0).set(samples);
+    const source = this.context.createBufferSource();
+    source.buffer = buffer;
+    this.player.output(source);
+    source.onended = () => this.sources.delete(source);
+    source.start(at);
+    this.sources.add(source);
+    this.timeline.place(samples.length, at);
+  }
+
+  /** Schedule the waiting span once the frame of its first sound is there: `delay` after its first piece came, or later. */
+  private release(): void {
+    if (this.waiting.length === 0) return;
+    const firstFrame = Math.floor((this.timeline.samples / this.rate) * this.fps);
+    // (Once ended, every frame is in: a last piece too short for a frame of its own waits no longer.)
+    if (this.computed <= firstFrame && !this.ended) return;
+    let at = Math.max(this.context.currentTime + SCHEDULE_MARGIN, this.waitingSince + this.delay, this.timeline.endTime);
+    this.spanDelay = at - this.waitingSince;
+    for (const piece of this.waiting.splice(0)) {
+      this.schedule(piece, at);
+      at += piece.length / this.rate;
+    }
+  }
+
+  private close(): void {
+    if (this.over) return;
+    this.over = true;
+    cancelAnimationFrame(this.tick);
+    for (const s of this.sources) {
+      s.onended = null;
+      s.stop();
+    }
+    this.sources.clear();
+    this.player.streamDone(this.stopper);
+    this.finish();
+  }
+
+  private draw = (): void => {
+    this.tick = 0;
+    if (this.over) return;
+    this.release();
+    const now = this.context.currentTime;
+    const at = this.timeline.at(now);
+    if (at && this.computed > 0) {
+      const f = Math.floor((at.sample / this.rate) * this.fps);
+      const late = f >= this.computed;
+      const shown = late ? this.computed - 1 : f;
+      const resting = at.quietFor > REST_AFTER_SECONDS;
+      if (shown !== this.shown || resting !== this.resting) {
+        if (late && shown !== this.shown) this.lateFrames++;
+        this.show(shown, !resting, shown !== this.shown);
+        [this.shown, this.resting] = [shown, resting];
+      }
+    }
+    if (this.ended && this.waiting.length === 0 && now >= this.timeline.endTime && this.shown >= this.computed - 1) {
+      if (this.computed > 0) this.show(this.computed - 1, false, false); // over: the face back to rest
+      this.playedOut = true;
+      return this.close();
+    }
+    this.timeline.forget(now);
+    this.tick = requestAnimationFrame(this.draw);
+  };
+
+  /** Show frame `f`; `sounding` false (the stream paused): the face rests. `report`: tell onFrame. */
+  private show(f: number, sounding: boolean, report = true): void {
+    while (this.chunks.length > 1 && this.chunks[1].first <= f - LIVE_REST_FRAMES) this.chunks.shift();
+    let k = this.chunks.length - 1;
+    while (k > 0 && this.chunks[k].first > f) k--;
+    const { first, frames } = this.chunks[k];
+    this.player.showFrame(frames, f - first, sounding && this.spoken(f));
+    if (report) this.options.onFrame?.(f, frames, f - first);
+  }
+
+  /** Whether speech was heard within the last LIVE_REST_FRAMES frames up to `f` (else the face rests, as live). */
+  private spoken(f: number): boolean {
+    for (const { first, frames } of this.chunks) {
+      for (let i = Math.max(0, f - LIVE_REST_FRAMES + 1 - first); i < frames.count && first + i <= f; i++) {
+        if (frames.speech[i] > SPEECH_PROBABILITY) return true;
+      }
+    }
+    return false;
+  }
+}
