@@ -225,8 +225,8 @@ export class Player {
     this.stop();
     this.streaming = stop;
     const context = (this.context ??= new AudioContext());
-    // Deliberate: resume() rejects only when the context is closed, and then start() throws with the reason.
-    this.watchAutoplay(context.resume().catch(() => undefined), () => this.streaming === stop);
+    const resumed = context.resume().catch(() => undefined); // rejects only on a closed context; start() then throws why
+    this.watchAutoplay(resumed, () => this.streaming === stop);
     return context;
   }
 
