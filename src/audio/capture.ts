@@ -46,20 +46,28 @@ export async function openMicrophone(): Promise<MediaStream> {
 /**
  * Linear-phase low-pass + fractional resampling, streaming: pieces in at `from` Hz, pieces out at
  * `to` Hz, continuous across pieces. A windowed-sinc kernel (cut-off just under the lower Nyquist).
+ * Output n sits at input time n * from / to; where that repeats its fraction every few outputs (24 or
+ * 48 kHz to 16 kHz: 2 and 1; 44.1 kHz: 160), each fraction's weights are computed once.
  */
 export class StreamResampler {
-  private readonly ratio: number;
+  private readonly step: number; // from / g: input samples per `phases` outputs
+  private readonly phases: number; // to / g: outputs before the fraction repeats
   private readonly half: number;
   private readonly cutoff: number;
+  private readonly table: Float32Array | null; // phases x 2 half weights, each row summing to 1
   private history: Float32Array;
-  private position = 0; // next output time, in input samples from the start of the stream
+  private made = 0; // outputs so far
   private received = 0; // input samples so far
 
-  constructor(readonly from: number, readonly to: number, taps = 16) {
-    this.ratio = from / to;
+  /** `maxPhases`: the most fractions whose weights are kept (beyond it, weights are computed per output). */
+  constructor(readonly from: number, readonly to: number, taps = 16, maxPhases = 1024) {
+    const g = gcd(from, to);
+    [this.step, this.phases] = [from / g, to / g];
     this.cutoff = Math.min(1, to / from) * 0.95;
     this.half = Math.ceil(taps / this.cutoff);
     this.history = new Float32Array(0);
+    this.table = this.phases <= maxPhases ? new Float32Array(this.phases * 2 * this.half) : null;
+    for (let ph = 0; this.table && ph < this.phases; ph++) this.weights(ph / this.phases, this.table.subarray(ph * 2 * this.half, (ph + 1) * 2 * this.half));
   }
 
   /** How long an output sample waits for input past its own time (half the kernel), in seconds. */
@@ -76,25 +84,41 @@ export class StreamResampler {
     const base = this.received - this.history.length; // input index of joined[0]
     this.received += input.length;
     const out: number[] = [];
-    // An output sample at input time p needs inputs up to p + half.
-    while (this.position + this.half < this.received) {
-      const p = this.position;
-      const centre = Math.floor(p);
-      let s = 0, wsum = 0;
-      for (let k = centre - this.half + 1; k <= centre + this.half; k++) {
-        const x = k - p;
-        const w = sinc(x * this.cutoff) * hann(x / (this.half + 1));
-        wsum += w;
-        const j = k - base;
-        if (k >= 0 && j >= 0 && j < joined.length) s += w * joined[j];
+    const w = this.table ? null : new Float32Array(2 * this.half);
+    // Output n sits at input time centre + phase / phases; it needs inputs up to centre + half.
+    for (;;) {
+      const centre = Math.floor(this.made / this.phases) * this.step + Math.floor(((this.made % this.phases) * this.step) / this.phases);
+      if (centre + this.half >= this.received) break;
+      const phase = (this.made * this.step) % this.phases;
+      const row = this.table ? this.table.subarray(phase * 2 * this.half, (phase + 1) * 2 * this.half) : this.weights(phase / this.phases, w!);
+      let s = 0;
+      for (let j = 0, k = centre - this.half + 1; j < row.length; j++, k++) {
+        const i = k - base;
+        if (k >= 0 && i >= 0 && i < joined.length) s += row[j] * joined[i];
       }
-      out.push(s / wsum);
-      this.position += this.ratio;
+      out.push(s);
+      this.made++;
     }
-    const keepFrom = Math.max(0, Math.floor(this.position) - this.half - base);
+    const next = Math.floor(this.made / this.phases) * this.step + Math.floor(((this.made % this.phases) * this.step) / this.phases);
+    const keepFrom = Math.max(0, next - this.half - base);
     this.history = joined.slice(keepFrom);
     return Float32Array.from(out);
   }
+
+  /** The kernel's weights for an output `fraction` (0..1) past its centre sample, taps centre - half + 1 .. centre + half, summing to 1. */
+  private weights(fraction: number, into: Float32Array): Float32Array {
+    let sum = 0;
+    for (let j = 0; j < into.length; j++) {
+      const x = j - this.half + 1 - fraction;
+      sum += into[j] = sinc(x * this.cutoff) * hann(x / (this.half + 1));
+    }
+    for (let j = 0; j < into.length; j++) into[j] /= sum;
+    return into;
+  }
+}
+
+function gcd(a: number, b: number): number {
+  return b === 0 ? a : gcd(b, a % b);
 }
 
 function sinc(x: number): number {
