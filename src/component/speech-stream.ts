@@ -12,6 +12,7 @@ import { checkedStreamRate, PcmReader, type PcmChunk } from '../audio/pcm';
 import type { Player } from '../player/player';
 import { StreamPlayback } from '../player/stream-playback';
 import { frameOptions } from './attributes';
+import { followMedia, mediaProblem, MEDIA_PIECE_SECONDS, MEDIA_RATE, type MediaFollower } from './media-speech';
 import { streamFrameDetail, type FrameDetail } from './events';
 import type { WorkHost } from './work-host';
 
@@ -24,8 +25,14 @@ export const STREAM_MARGIN_SECONDS = 0.15;
 export const FIRST_PIECE_SECONDS = 0.25;
 
 export interface SpeechStreamOptions {
-  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM). */
-  sampleRate: number;
+  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM), for pieces the page writes. */
+  sampleRate?: number;
+  /**
+   * Or a MediaStream to follow instead (a voice agent's WebRTC track): its sound is played, with the face, from the
+   * element (leave it unplayed elsewhere: it would be heard twice) until its audio ends or end() or stop() is called.
+   * Its tracks are left running. No take is kept (a call may last hours).
+   */
+  media?: MediaStream;
   /**
    * How long after the first piece arrives its sound starts (ms). Default: the model's look-ahead, the first piece's
    * length (at most 0.25 s) and 150 ms to compute in: about 0.36 s for pieces of 0.1 s. Where frames come late all the
@@ -51,11 +58,17 @@ export class SpeechStream {
   private playback: StreamPlayback | null = null;
   private started: { engine: TalkingFaceEngine; player: Player } | null = null;
   private chunks: { first: number; frames: Frames }[] = [];
+  private media: { stream: MediaStream; follower: MediaFollower | null } | null = null; // speakStream({ media })
   private settle: { resolve: () => void; reject: (e: Error) => void } = { resolve: () => undefined, reject: () => undefined };
 
   /** `keep`: called once it has played out, with the whole take (the element keeps it for currentAnimation and recordVideo). */
   constructor(options: SpeechStreamOptions, private readonly host: WorkHost, private readonly keep: (animation: Animation, buffer: AudioBuffer) => void) {
-    this.sampleRate = checkedStreamRate(options?.sampleRate, 'speakStream');
+    if (options?.media !== undefined) {
+      const problem = options.sampleRate === undefined ? mediaProblem(options.media) : 'give sampleRate (pieces written) or media (a MediaStream), not both';
+      if (problem) throw new TypeError(`speakStream: ${problem}`);
+      this.media = { stream: options.media, follower: null };
+    }
+    this.sampleRate = this.media ? MEDIA_RATE : checkedStreamRate(options?.sampleRate, 'speakStream');
     if (options.delayMs !== undefined && !(options.delayMs >= 0 && options.delayMs <= 10000)) {
       throw new RangeError(`speakStream: delayMs must be from 0 to 10000 ms; it was ${options.delayMs}`);
     }
@@ -89,19 +102,29 @@ export class SpeechStream {
    * TypeError or RangeError for a piece that is not audio.
    */
   write(chunk: PcmChunk): boolean {
-    if (this.closed || this.ended) return false;
-    const samples = this.reader.read(chunk);
+    if (this.media) throw new TypeError('SpeechStream.write: this stream follows a MediaStream; write() is for a stream opened with a sampleRate');
+    return this.accept(this.closed || this.ended ? null : this.reader.read(chunk));
+  }
+
+  /** A piece (null: the stream is over); kept for the take unless following a MediaStream. */
+  private accept(samples: Float32Array | null): boolean {
+    if (!samples || this.closed || this.ended) return false;
     if (samples.length === 0) return true;
-    this.pieces.push(samples);
+    if (!this.media) this.pieces.push(samples);
     this.written += samples.length;
     if (this.started) this.feed(samples);
     else this.pending.push(samples);
     return true;
   }
 
-  /** No more pieces: `done` resolves once the last has played. */
+  /** No more pieces (a MediaStream is no longer followed): `done` resolves once the last has played. */
   end(): void {
     if (this.closed || this.ended) return;
+    const follower = this.media?.follower;
+    if (follower) { // its last pieces first
+      this.media!.follower = null;
+      return void follower.stop().then(() => this.end(), () => this.end());
+    }
     this.ended = true;
     if (this.started) void this.finish();
   }
@@ -120,10 +143,20 @@ export class SpeechStream {
     this.session = engine.createStream((first, frames) => this.frames(first, frames), frameOptions(this.host.element));
     this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
     const lookAhead = this.session.lookAheadMs / 1000;
-    const first = Math.min(FIRST_PIECE_SECONDS, this.pending.length ? this.pending[0].length / this.sampleRate : 0.1);
+    const first = Math.min(FIRST_PIECE_SECONDS, this.media ? MEDIA_PIECE_SECONDS : this.pending.length ? this.pending[0].length / this.sampleRate : 0.1);
     this.delay = delayMs !== undefined ? delayMs / 1000 : lookAhead + first + STREAM_MARGIN_SECONDS;
     for (const p of this.pending.splice(0)) this.feed(p);
     if (this.ended) void this.finish();
+    else if (this.media) await this.follow(this.media);
+  }
+
+  private async follow(media: { stream: MediaStream; follower: MediaFollower | null }): Promise<void> {
+    try {
+      media.follower = await followMedia(media.stream, (piece) => this.accept(piece), () => this.end());
+    } catch (e) {
+      return this.fail(this.host.fail('audio', `the MediaStream's sound could not be followed: ${(e as Error).message}`));
+    }
+    if (this.closed || this.ended) void media.follower.stop(); // ended or stopped while the capture started
   }
 
   private feed(samples: Float32Array): void {
@@ -148,7 +181,7 @@ export class SpeechStream {
 
   private frames(first: number, frames: Frames): void {
     if (this.closed) return;
-    this.chunks.push({ first, frames });
+    if (!this.media) this.chunks.push({ first, frames });
     this.playback?.frames(first, frames);
   }
 
@@ -168,7 +201,8 @@ export class SpeechStream {
     if (!this.playback) return this.close(); // nothing was written
     this.playback.end();
     await this.playback.done;
-    if (!this.playback.playedOut || !this.host.current() || this.chunks.length === 0) return this.close();
+    if (!this.playback.playedOut || !this.host.current()) return this.close();
+    if (this.media || this.chunks.length === 0) return this.over(`Played the stream's speech (${this.seconds.toFixed(1)} s).`);
     const total = this.chunks.at(-1)!.first + this.chunks.at(-1)!.frames.count;
     const buffer = new AudioBuffer({ length: this.written, numberOfChannels: 1, sampleRate: this.sampleRate });
     let at = 0;
@@ -178,7 +212,12 @@ export class SpeechStream {
     }
     this.pieces = [];
     this.keep(placeFrames(this.chunks, total, this.started!.engine.fps), buffer);
-    this.host.status(`Played streamed speech (${buffer.duration.toFixed(1)} s${this.playback.lateFrames ? `; ${this.playback.lateFrames} frames came late` : ''}).`);
+    this.over(`Played streamed speech (${buffer.duration.toFixed(1)} s${this.playback.lateFrames ? `; ${this.playback.lateFrames} frames came late` : ''}).`);
+  }
+
+  /** Played out: say so, send `ended`, settle `done`. */
+  private over(status: string): void {
+    this.host.status(status);
     this.host.dispatch(new CustomEvent('ended'));
     this.close();
   }
@@ -197,6 +236,7 @@ export class SpeechStream {
   private close(): void {
     if (this.closed) return;
     this.closed = true;
+    void this.media?.follower?.stop();
     this.playback?.stop();
     this.pending = [];
     this.settle.resolve();

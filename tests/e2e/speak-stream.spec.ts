@@ -1,13 +1,16 @@
 import { resolve } from 'node:path';
 import { test, expect } from './fixtures';
-import { framesOf, SAMPLE_RATE } from './helpers/audio';
+import { fakeMicrophone } from '../../playwright.config';
+import { framesOf, SAMPLE_RATE, SPEECH } from './helpers/audio';
 
 /**
  * <talking-face>'s speakStream(): speech written in pieces as a streaming text-to-speech or a voice agent sends them,
  * animated and played as it comes. The take it leaves equals the offline animation of the same audio; 16-bit bytes at
- * 24 kHz cut anywhere give the same mouth; stop() ends it at once; bad input gets a clear message.
+ * 24 kHz cut anywhere give the same mouth; stop() ends it at once; bad input gets a clear message; a MediaStream (here the
+ * fake microphone's, as a voice agent's WebRTC track would be) is followed, its tracks left running.
  */
 const SAMPLE = resolve(import.meta.dirname, '../../examples/sample.wav');
+test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
 interface Outcome { frames: number; streamFrames: number[]; ended: number; errors: string[]; late: number; delayMs: number; status: string;
   maxDiff: number; poseDiff: number; video: number }
@@ -151,4 +154,51 @@ test('stop() ends a stream at once; bad pieces and options get clear messages; a
   expect(r.after).toEqual({ written: false, status: 'Stopped.', take: null });
   expect(r.events).toEqual(['error:audio', 'error:audio', 'ended', 'ended']);
   expect(r.frames).toBe(30);
+});
+
+test('a MediaStream is followed with the face until its audio ends, its tracks left running; write() is refused on it', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/examples/embed.html');
+  const r = await page.evaluate(async () => {
+    type Stream = { write(p: unknown): boolean; end(): void; done: Promise<void>; seconds: number; delayMs: number };
+    const el = document.getElementById('left') as HTMLElement & { speakStream(o: unknown): Stream; stop(): void; ready: Promise<unknown> };
+    await el.ready;
+    const media = await navigator.mediaDevices.getUserMedia({ audio: true });
+    const frames: number[] = [];
+    let ended = 0;
+    el.addEventListener('frame', (e) => {
+      const d = (e as CustomEvent).detail;
+      if (d.mode === 'stream') frames.push(d.frame);
+    });
+    el.addEventListener('ended', () => ended++);
+    const messages: string[] = [];
+    for (const options of [{ media: 'not a stream' }, { media, sampleRate: 16000 }]) {
+      try { el.speakStream(options); } catch (e) { messages.push((e as Error).message); }
+    }
+    const speech = el.speakStream({ media });
+    try { speech.write(new Float32Array(10)); } catch (e) { messages.push((e as Error).message); }
+    await new Promise((res) => setTimeout(res, 3000));
+    const during = { frames: frames.length, seconds: speech.seconds, delay: speech.delayMs, status: el.shadowRoot!.querySelector('p.status')!.textContent };
+    media.getAudioTracks()[0].stop(); // the agent hangs up: the rest plays out
+    const settled = await Promise.race([speech.done.then(() => 'resolved'), new Promise((res) => setTimeout(() => res('pending'), 10_000))]);
+    const second = await navigator.mediaDevices.getUserMedia({ audio: true });
+    const again = el.speakStream({ media: second });
+    await new Promise((res) => setTimeout(res, 1500));
+    el.stop();
+    await again.done;
+    return { messages, during, settled, ended, status: el.shadowRoot!.querySelector('p.status')!.textContent, left: second.getAudioTracks()[0].readyState };
+  });
+  console.log(`followed the fake microphone: ${JSON.stringify(r.during)}`);
+  expect(r.messages).toEqual([
+    "speakStream: media must be a MediaStream (a WebRTC track's stream, getUserMedia's, captureStream()'s)",
+    'speakStream: give sampleRate (pieces written) or media (a MediaStream), not both',
+    'SpeechStream.write: this stream follows a MediaStream; write() is for a stream opened with a sampleRate',
+  ]);
+  expect(r.during.frames).toBeGreaterThan(10);
+  expect(r.during.seconds).toBeGreaterThan(1.5);
+  expect(r.during.status).toMatch(/^Playing streamed speech \(\d+ ms behind it, cpu\)\.$/);
+  expect(r.settled).toBe('resolved');
+  expect(r.ended).toBe(2); // played out, then stopped
+  expect(r.status).toBe('Stopped.');
+  expect(r.left).toBe('live'); // stop() leaves the page's stream running
 });
