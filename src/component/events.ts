@@ -71,8 +71,8 @@ export interface TalkingFaceEventMap extends Omit<HTMLElementEventMap, 'error'> 
 export function playbackFrameDetail(engine: TalkingFaceEngine, a: Animation, frame: number, computeMs: number, audioSeconds: number): FrameDetail {
   return {
     frame, time: frame / a.fps, mode: 'playback', backend: engine.backend,
-    inferenceMs: computeMs / a.frames,
-    realTimeFactor: audioSeconds < SHORT_CLIP_SECONDS ? undefined : audioSeconds / (computeMs / 1000),
+    inferenceMs: Number.isFinite(computeMs) ? computeMs / a.frames : undefined, // (not for a streamed take: NaN)
+    realTimeFactor: audioSeconds < SHORT_CLIP_SECONDS || !Number.isFinite(computeMs) ? undefined : audioSeconds / (computeMs / 1000),
     ...(a.blendshapes && frameWeights(a.blendshapes, frame)),
   };
 }

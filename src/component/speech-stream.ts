@@ -41,6 +41,17 @@ export interface SpeechStreamOptions {
   delayMs?: number;
 }
 
+/** speakStream()'s options, checked before the element stops what it does: a bad one throws a TypeError or RangeError. */
+export function checkedStreamOptions(options: SpeechStreamOptions): { sampleRate: number; media: MediaStream | null; delayMs: number | undefined } {
+  const { sampleRate, media, delayMs } = options ?? {};
+  if (media !== undefined) {
+    const problem = sampleRate === undefined ? mediaProblem(media) : 'give sampleRate (pieces written) or media (a MediaStream), not both';
+    if (problem) throw new TypeError(`speakStream: ${problem}`);
+  }
+  if (delayMs !== undefined && !(delayMs >= 0 && delayMs <= 10000)) throw new RangeError(`speakStream: delayMs must be from 0 to 10000 ms; it was ${delayMs}`);
+  return { sampleRate: media ? MEDIA_RATE : checkedStreamRate(sampleRate, 'speakStream'), media: media ?? null, delayMs };
+}
+
 export class SpeechStream {
   /** Resolves once everything written has played (after end()), or on stop(); rejects if the stream failed. */
   readonly done: Promise<void>;
@@ -50,9 +61,10 @@ export class SpeechStream {
   private pending: Float32Array[] = []; // written before the model and the face were there
   private written = 0; // samples written, at sampleRate
   private pushed = 0; // samples pushed into the engine's stream, at the model's rate
-  private delay = 0; // seconds from a piece's arrival to its sound
   private ended = false;
+  private ending = false; // end() waits for a MediaStream's last pieces
   private closed = false;
+  private failure: Error | null = null;
   private session: StreamSession | null = null;
   private resampler: StreamResampler | null = null;
   private playback: StreamPlayback | null = null;
@@ -61,21 +73,26 @@ export class SpeechStream {
   private media: { stream: MediaStream; follower: MediaFollower | null } | null = null; // speakStream({ media })
   private settle: { resolve: () => void; reject: (e: Error) => void } = { resolve: () => undefined, reject: () => undefined };
 
-  /** `keep`: called once it has played out, with the whole take (the element keeps it for currentAnimation and recordVideo). */
-  constructor(options: SpeechStreamOptions, private readonly host: WorkHost, private readonly keep: (animation: Animation, buffer: AudioBuffer) => void) {
-    if (options?.media !== undefined) {
-      const problem = options.sampleRate === undefined ? mediaProblem(options.media) : 'give sampleRate (pieces written) or media (a MediaStream), not both';
-      if (problem) throw new TypeError(`speakStream: ${problem}`);
-      this.media = { stream: options.media, follower: null };
-    }
-    this.sampleRate = this.media ? MEDIA_RATE : checkedStreamRate(options?.sampleRate, 'speakStream');
-    if (options.delayMs !== undefined && !(options.delayMs >= 0 && options.delayMs <= 10000)) {
-      throw new RangeError(`speakStream: delayMs must be from 0 to 10000 ms; it was ${options.delayMs}`);
-    }
+  /**
+   * `options` as checkedStreamOptions gives them; `keep`: called once it has played out, with the whole take (the element
+   * keeps it for currentAnimation and recordVideo).
+   */
+  constructor(options: ReturnType<typeof checkedStreamOptions>, private readonly host: WorkHost,
+    private readonly keep: (animation: Animation, buffer: AudioBuffer) => void) {
+    this.sampleRate = options.sampleRate;
+    if (options.media) this.media = { stream: options.media, follower: null };
+    this.delayMs0 = options.delayMs;
     this.done = new Promise((resolve, reject) => (this.settle = { resolve, reject }));
     this.done.catch(() => undefined); // deliberate: the failure is also an `error` event; a page need not await done
     host.signal.addEventListener('abort', () => this.close(), { once: true });
-    void this.start(options.delayMs);
+    void this.start();
+  }
+
+  private readonly delayMs0: number | undefined; // the page's delayMs
+
+  /** Whether it may still play (not played out, stopped or failed). */
+  get open(): boolean {
+    return !this.closed;
   }
 
   /** Seconds of speech written so far. */
@@ -103,7 +120,7 @@ export class SpeechStream {
    */
   write(chunk: PcmChunk): boolean {
     if (this.media) throw new TypeError('SpeechStream.write: this stream follows a MediaStream; write() is for a stream opened with a sampleRate');
-    return this.accept(this.closed || this.ended ? null : this.reader.read(chunk));
+    return this.accept(this.closed || this.ended || this.ending ? null : this.reader.read(chunk));
   }
 
   /** A piece (null: the stream is over); kept for the take unless following a MediaStream. */
@@ -119,17 +136,20 @@ export class SpeechStream {
 
   /** No more pieces (a MediaStream is no longer followed): `done` resolves once the last has played. */
   end(): void {
-    if (this.closed || this.ended) return;
+    if (this.closed || this.ended || this.ending) return;
     const follower = this.media?.follower;
     if (follower) { // its last pieces first
-      this.media!.follower = null;
-      return void follower.stop().then(() => this.end(), () => this.end());
+      this.ending = true;
+      return void follower.stop().finally(() => {
+        [this.ending, this.media!.follower] = [false, null];
+        this.end();
+      });
     }
     this.ended = true;
     if (this.started) void this.finish();
   }
 
-  private async start(delayMs: number | undefined): Promise<void> {
+  private async start(): Promise<void> {
     let engine: TalkingFaceEngine | null, player: Player | null;
     try {
       engine = await this.host.engine;
@@ -142,9 +162,6 @@ export class SpeechStream {
     this.started = { engine, player };
     this.session = engine.createStream((first, frames) => this.frames(first, frames), frameOptions(this.host.element));
     this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
-    const lookAhead = this.session.lookAheadMs / 1000;
-    const first = Math.min(FIRST_PIECE_SECONDS, this.media ? MEDIA_PIECE_SECONDS : this.pending.length ? this.pending[0].length / this.sampleRate : 0.1);
-    this.delay = delayMs !== undefined ? delayMs / 1000 : lookAhead + first + STREAM_MARGIN_SECONDS;
     for (const p of this.pending.splice(0)) this.feed(p);
     if (this.ended) void this.finish();
     else if (this.media) await this.follow(this.media);
@@ -159,19 +176,32 @@ export class SpeechStream {
     if (this.closed || this.ended) void media.follower.stop(); // ended or stopped while the capture started
   }
 
+  /** The delay before the first piece's sound (s): the page's, or the look-ahead, the first piece and a margin. */
+  private firstDelay(first: Float32Array): number {
+    if (this.delayMs0 !== undefined) return this.delayMs0 / 1000;
+    const piece = this.media ? MEDIA_PIECE_SECONDS : first.length / this.sampleRate;
+    return this.session!.lookAheadMs / 1000 + Math.min(FIRST_PIECE_SECONDS, piece) + STREAM_MARGIN_SECONDS;
+  }
+
   private feed(samples: Float32Array): void {
     const { engine, player } = this.started!;
     if (!this.playback) {
-      this.playback = new StreamPlayback(player, this.sampleRate, engine.fps, this.delay, {
+      const delay = this.firstDelay(samples);
+      this.playback = new StreamPlayback(player, this.sampleRate, engine.fps, delay, {
         onFrame: (frame, frames, at) => this.host.dispatch(new CustomEvent<FrameDetail>('frame',
           { detail: streamFrameDetail(engine, frame, frames, at, this.playback?.lateFrames ?? 0) })),
       });
       void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with the player
-
-      this.host.playing(`Playing streamed speech (${Math.round(this.delay * 1000)} ms behind it, ${engine.backend}).`);
+      this.host.playing(`Playing streamed speech (${Math.round(delay * 1000)} ms behind it, ${engine.backend}).`);
+    }
+    let pushed: Promise<void>;
+    try {
+      pushed = this.push(this.resampler!.push(samples));
+    } catch (e) {
+      return this.broken(e as Error); // (write() checks each piece first: not expected)
     }
     this.playback.write(samples);
-    this.push(this.resampler!.push(samples)).catch((e: Error) => this.broken(e));
+    pushed.catch((e: Error) => this.broken(e));
   }
 
   private push(samples: Float32Array): Promise<void> {
@@ -228,17 +258,19 @@ export class SpeechStream {
   }
 
   private fail(e: Error): void {
+    this.failure ??= e;
     this.close();
-    this.settle.reject(e);
   }
 
-  /** Over: stopped, played out or failed. The sound stops (if it still plays) and `done` settles. */
+  /** Over: stopped, played out or failed. The sound stops (if it still plays), the engine's work on it too, and `done` settles. */
   private close(): void {
     if (this.closed) return;
     this.closed = true;
     void this.media?.follower?.stop();
+    this.session?.cancel();
     this.playback?.stop();
-    this.pending = [];
-    this.settle.resolve();
+    [this.pending, this.pieces, this.chunks] = [[], [], []];
+    if (this.failure) this.settle.reject(this.failure);
+    else this.settle.resolve();
   }
 }

@@ -19,7 +19,7 @@ import { ElementStage } from './stage';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { SpeechStream, type SpeechStreamOptions } from './speech-stream';
+import { checkedStreamOptions, SpeechStream, type SpeechStreamOptions } from './speech-stream';
 import { listenLive } from './microphone';
 import type { WorkHost } from './work-host';
 import { playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
@@ -41,6 +41,7 @@ export class TalkingFaceElement extends ElementBase {
   private loading: Promise<TalkingFaceEngine> | null = null;
   private hold: EngineHold | null = null; // on the shared engine (engines.ts): released when removed or switched
   private liveSession: LiveSession | null = null; // (not `live`: a framework would set it for the `live` attribute)
+  private speech: SpeechStream | null = null; // the last speakStream()
   private animation: Animation | null = null;
   private computeMs = 0;
   private audioSeconds = 0;
@@ -169,17 +170,19 @@ export class TalkingFaceElement extends ElementBase {
    * the last piece; each piece is animated and played, the face in sync, a short delay after it arrives. docs/embedding.md.
    */
   speakStream(options: SpeechStreamOptions): SpeechStream {
-    const { gen, signal } = this.begin();
-    const work = this.work;
+    let checked: ReturnType<typeof checkedStreamOptions>;
     try {
-      return new SpeechStream(options, this.host(gen, signal), (animation, buffer) => {
-        if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
-        this.animation = animation;
-        this.stage.player?.load(animation, buffer); // for recordVideo()
-      });
+      checked = checkedStreamOptions(options); // before anything under way is stopped
     } catch (e) {
       throw this.fail('audio', (e as Error).message);
     }
+    const { gen, signal } = this.begin();
+    const work = this.work;
+    return (this.speech = new SpeechStream(checked, this.host(gen, signal), (animation, buffer) => {
+      if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
+      [this.animation, this.computeMs, this.audioSeconds] = [animation, NaN, buffer.duration]; // (no compute time of its own)
+      this.stage.player?.load(animation, buffer); // for recordVideo()
+    }));
   }
 
   /** What work of generation `gen` (stopped by `signal`) is lent: the model, the player, the status line, the events. */
@@ -200,7 +203,8 @@ export class TalkingFaceElement extends ElementBase {
   async startMicrophone(): Promise<void> {
     const { gen, signal } = this.begin();
     const live = await listenLive(this.host(gen, signal), (stage, message) => this.lost(stage, message));
-    if (live) [this.liveSession, this.work] = [live, null];
+    if (live && gen !== this.generation) void live.stop(); // stopped as it started: the microphone released
+    else if (live) [this.liveSession, this.work] = [live, null];
   }
 
   /**
@@ -209,6 +213,7 @@ export class TalkingFaceElement extends ElementBase {
    */
   async recordVideo(options: { signal?: AbortSignal; onProgress?: (seconds: number) => void } = {}): Promise<Blob> {
     const { engine, animation } = this;
+    if (this.speech?.open) throw this.fail('render', 'streamed speech is playing: record once it has played (its take is then recorded)');
     if (!engine || !animation) throw this.fail('render', 'there is no take to record: speak() one first');
     return this.stage.recordVideo(engine.fps, options.signal ?? new AbortController().signal, (f) => options.onProgress?.(f / engine.fps))
       .catch((e: Error) => Promise.reject(options.signal?.aborted ? e : this.fail('render', `the video could not be made: ${e.message}`)));

@@ -14,6 +14,7 @@ export class StreamSession {
   private received = 0; // samples received so far
   private next = 0; // next frame to produce
   private ended = false;
+  private cancelled = false;
   private readonly state: ProducerState;
   private busy: Promise<void> = Promise.resolve();
   /** Arrival of recent pushes: the stream's sample count after the push, and the time (ms) it came. */
@@ -66,7 +67,7 @@ export class StreamSession {
 
   /** Append mono samples at the model's rate; resolves when every frame they make ready has been emitted. */
   push(samples: Float32Array): Promise<void> {
-    if (this.ended) throw new Error('StreamSession: push() after end()');
+    if (this.ended) throw new Error(`StreamSession: push() after ${this.cancelled ? 'cancel' : 'end'}()`);
     this.append(checkedSamples(samples, 'StreamSession.push'));
     this.arrivals.push({ end: this.received, time: performance.now() });
     // Pushes that come while a drain runs share one follow-up drain: at most one waits, however fast
@@ -80,8 +81,17 @@ export class StreamSession {
     return this.pending;
   }
 
+  /**
+   * Nothing more is wanted: the frames under way are not emitted, and no more are computed (a push or end() after it
+   * throws, as after end()).
+   */
+  cancel(): void {
+    this.ended = this.cancelled = true;
+  }
+
   /** No more audio: emit the remaining frames (the end of the clip is zero-padded, as offline). */
   end(): Promise<void> {
+    if (this.cancelled) throw new Error('StreamSession: end() after cancel()');
     this.ended = true;
     return this.schedule(() => this.drain(true));
   }
@@ -115,10 +125,11 @@ export class StreamSession {
       this.skippedFrames += resume - this.next;
       this.next = resume;
     }
-    for (let f0 = this.next; f0 < f1; f0 += DEFAULT_CHUNK_FRAMES) {
+    for (let f0 = this.next; f0 < f1 && !this.cancelled; f0 += DEFAULT_CHUNK_FRAMES) {
       const to = Math.min(f1, f0 + DEFAULT_CHUNK_FRAMES);
       const view = this.buffer.subarray(0, this.received - this.offset);
       const out = await e.produce(this.state, f0, to, view, this.offset, total);
+      if (this.cancelled) return;
       this.next = to;
       if (!final) this.measure(f0, to);
       this.onFrames(f0, out);

@@ -19,6 +19,8 @@ export const LATE_TOLERANCE = 0.04;
 export const GROW_MARGIN = 0.1;
 /** The delay never grows beyond this (s). */
 export const MAX_DELAY = 3;
+/** Spans of sound over for longer than this (s) are forgotten: frames that late still count as late. */
+const FORGET_AFTER = 2 * MAX_DELAY;
 
 export interface StreamPlaybackOptions {
   /** Called for each frame shown: the stream's frame `frame`, which is `frames`' frame `at`. */
@@ -49,6 +51,7 @@ export class StreamPlayback {
   private shown = -1;
   private resting = false; // the sound has paused long enough for the face to rest
   private finish: () => void = () => undefined;
+  private endTimer: ReturnType<typeof setTimeout> | undefined;
   private readonly stopper = () => this.close();
 
   /** `rate`: the pieces' sample rate; `fps`: the frames'; `delay`: seconds from a span's first piece arriving to its sound. */
@@ -68,10 +71,7 @@ export class StreamPlayback {
     if (this.needed > this.delay) this.delay = Math.min(MAX_DELAY, this.needed); // and this piece starts a new span
     else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
     this.needed = 0;
-    if (this.waiting.length === 0) {
-      this.waitingSince = now;
-      if (this.timeline.samples > 0) this.pauses++;
-    }
+    if (this.waiting.length === 0) this.waitingSince = now;
     this.waiting.push(samples);
     this.release();
   }
@@ -87,9 +87,11 @@ export class StreamPlayback {
     this.release();
   }
 
-  /** No more pieces: once the last has played (and its frames come), the playback is over. */
+  /** No more pieces, and every frame of them has come: once the last has played, the playback is over. */
   end(): void {
     this.ended = true;
+    this.release(); // a last piece too short for a frame of its own
+    this.endLater();
   }
 
   /** Stop the sound now; `done` resolves. */
@@ -116,17 +118,39 @@ export class StreamPlayback {
     // (Once ended, every frame is in: a last piece too short for a frame of its own waits no longer.)
     if (this.computed <= firstFrame && !this.ended) return;
     let at = Math.max(this.context.currentTime + SCHEDULE_MARGIN, this.waitingSince + this.delay, this.timeline.endTime);
+    if (at > this.timeline.endTime + 1e-6 && this.timeline.samples > 0) this.pauses++; // a gap in the sound
     this.spanDelay = at - this.waitingSince;
     for (const piece of this.waiting.splice(0)) {
       this.schedule(piece, at);
       at += piece.length / this.rate;
     }
+    if (this.ended) this.endLater();
+  }
+
+  /**
+   * Look for the end once the sound has played, on a timer as well as on animation frames: a page in a background tab
+   * gets none, and its voice agent still waits for `done` to listen again.
+   */
+  private endLater(): void {
+    clearTimeout(this.endTimer);
+    const wait = Math.max(0, this.timeline.endTime - this.context.currentTime);
+    this.endTimer = setTimeout(() => this.over || this.ending(this.context.currentTime) || this.endLater(), 1000 * (wait + SCHEDULE_MARGIN));
+  }
+
+  /** Over once ended, nothing waits, the sound has played and the last frame was shown (or none can be): true then. */
+  private ending(now: number): boolean {
+    if (!this.ended || this.waiting.length > 0 || now < this.timeline.endTime) return false;
+    if (this.computed > 0) this.show(this.computed - 1, false, this.computed - 1 !== this.shown); // over: the face back to rest
+    this.playedOut = true;
+    this.close();
+    return true;
   }
 
   private close(): void {
     if (this.over) return;
     this.over = true;
     cancelAnimationFrame(this.tick);
+    clearTimeout(this.endTimer);
     for (const s of this.sources) {
       s.onended = null;
       s.stop();
@@ -153,12 +177,8 @@ export class StreamPlayback {
         [this.shown, this.resting] = [shown, resting];
       }
     }
-    if (this.ended && this.waiting.length === 0 && now >= this.timeline.endTime && this.shown >= this.computed - 1) {
-      if (this.computed > 0) this.show(this.computed - 1, false, false); // over: the face back to rest
-      this.playedOut = true;
-      return this.close();
-    }
-    this.timeline.forget(now);
+    if (this.ending(now)) return;
+    this.timeline.forget(now - FORGET_AFTER);
     this.tick = requestAnimationFrame(this.draw);
   };
 

@@ -116,7 +116,7 @@ test('stop() ends a stream at once; bad pieces and options get clear messages; a
   guard.allowConsoleError(/sampleRate must be/);
   await page.goto('/examples/embed.html');
   const r = await page.evaluate(async () => {
-    type Stream = { write(p: unknown): boolean; end(): void; done: Promise<void> };
+    type Stream = { write(p: unknown): boolean; end(): void; done: Promise<void>; open: boolean };
     const el = document.getElementById('left') as HTMLElement & { speakStream(o: unknown): Stream; stop(): void; ready: Promise<unknown>;
       currentAnimation: { frames: number } | null };
     await el.ready;
@@ -125,8 +125,6 @@ test('stop() ends a stream at once; bad pieces and options get clear messages; a
     const tone = (seconds: number) => Float32Array.from({ length: 16000 * seconds }, (_, i) => 0.3 * Math.sin(i / 9) * Math.sin(i / 3000));
     const messages: string[] = [];
     const caught = (run: () => unknown) => { try { run(); } catch (e) { messages.push(`${(e as Error).name}: ${(e as Error).message}`); } };
-    caught(() => el.speakStream({}));
-    caught(() => el.speakStream({ sampleRate: 16000, delayMs: -5 }));
     const s = el.speakStream({ sampleRate: 16000 });
     caught(() => s.write('AAAA'));
     caught(() => s.write(Float32Array.of(0, Infinity)));
@@ -134,6 +132,9 @@ test('stop() ends a stream at once; bad pieces and options get clear messages; a
     await new Promise((r) => setTimeout(r, 800)); // playing
     const status = () => el.shadowRoot!.querySelector('p.status')!.textContent!;
     const during = status();
+    caught(() => el.speakStream({})); // bad options: said, and what plays goes on
+    caught(() => el.speakStream({ sampleRate: 16000, delayMs: -5 }));
+    const goesOn = s.open;
     el.stop();
     const stopped = await Promise.race([s.done.then(() => 'resolved'), new Promise((r) => setTimeout(() => r('pending'), 2000))]);
     const after = { written: s.write(tone(1)), status: status(), take: el.currentAnimation };
@@ -141,14 +142,15 @@ test('stop() ends a stream at once; bad pieces and options get clear messages; a
     again.write(tone(1));
     again.end();
     await again.done;
-    return { messages, during, stopped, after, events, frames: el.currentAnimation?.frames ?? 0 };
+    return { messages, during, goesOn, stopped, after, events, frames: el.currentAnimation?.frames ?? 0 };
   });
   expect(r.messages).toEqual([
-    expect.stringMatching(/^TalkingFaceError: speakStream: sampleRate must be the stream's rate in Hz, a whole number from 8000 to 96000 .* it was undefined$/),
-    expect.stringMatching(/^TalkingFaceError: speakStream: delayMs must be from 0 to 10000 ms; it was -5$/),
     expect.stringMatching(/^TypeError: SpeechStream\.write takes a Float32Array .*a string \(base64 text\? decode it to bytes first\)$/),
     expect.stringMatching(/^RangeError: SpeechStream\.write: sample 1 of the piece is Infinity/),
+    expect.stringMatching(/^TalkingFaceError: speakStream: sampleRate must be the stream's rate in Hz, a whole number from 8000 to 96000 .* it was undefined$/),
+    expect.stringMatching(/^TalkingFaceError: speakStream: delayMs must be from 0 to 10000 ms; it was -5$/),
   ]);
+  expect(r.goesOn).toBe(true);
   expect(r.during).toMatch(/^Playing streamed speech \(\d+ ms behind it, cpu\)\.$/);
   expect(r.stopped).toBe('resolved');
   expect(r.after).toEqual({ written: false, status: 'Stopped.', take: null });

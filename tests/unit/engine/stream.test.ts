@@ -49,6 +49,21 @@ describe('StreamSession', () => {
     expect(() => stream.push(new Float32Array(1))).toThrow(/after end/);
   });
 
+  it('cancel() stops the work under way: no frame of it is emitted, and nothing more is taken', async () => {
+    const calls: [number, number, number][] = [];
+    const got: number[] = [];
+    const stream = new StreamSession(standIn(calls), (first) => got.push(first));
+    await stream.push(new Float32Array(300));
+    expect(got).toEqual([0]);
+    const pushed = stream.push(new Float32Array(5000)); // 50 frames ready: computed in chunks
+    stream.cancel();
+    await pushed;
+    expect(got).toEqual([0]);
+    expect(calls.length).toBeLessThanOrEqual(2); // at most the chunk under way
+    expect(() => stream.push(new Float32Array(1))).toThrow(/push\(\) after cancel\(\)/);
+    expect(() => stream.end()).toThrow(/end\(\) after cancel\(\)/);
+  });
+
   it('with a lag limit, a device that falls behind skips to the newest frames and counts what it skipped', async () => {
     const calls: [number, number, number][] = [];
     const firsts: number[] = [];

@@ -179,6 +179,18 @@ describe('StreamPlayback', () => {
     expect(p.playedOut).toBe(true);
   });
 
+  it('ends without animation frames too (a background tab gets none), once its sound has played', async () => {
+    const { player, shown } = stage();
+    const p = new StreamPlayback(player, RATE, FPS, 0.1);
+    p.write(new Float32Array(200)); // plays 0.1 .. 0.3
+    p.frames(0, frames(0, 2));
+    p.end();
+    FakeContext.last.currentTime = 0.35; // no draw meanwhile
+    await p.done;
+    expect(p.playedOut).toBe(true);
+    expect(shown).toEqual([1]); // the last frame, at rest
+  });
+
   it('stops at once: every piece silenced, done resolved, and nothing scheduled after', async () => {
     const { player } = stage();
     const p = new StreamPlayback(player, RATE, FPS, 0);
