@@ -4,7 +4,7 @@
  */
 
 /** What a piece of streamed speech may be (SpeechStream.write). */
-export type PcmChunk = Float32Array | Int16Array | ArrayBuffer | Uint8Array | DataView;
+export type PcmChunk = Float32Array | Int16Array | ArrayBuffer | SharedArrayBuffer | Uint8Array | DataView;
 
 /** Where a stream's sample rate must lie: what an AudioBuffer accepts in every browser. */
 export const MIN_STREAM_RATE = 8000;
@@ -20,10 +20,10 @@ export class PcmReader {
   read(chunk: unknown): Float32Array {
     if (chunk instanceof Float32Array) return finite(chunk.slice(), this.where);
     if (chunk instanceof Int16Array) return fromInt16(chunk);
-    if (chunk instanceof ArrayBuffer) return this.bytes(new Uint8Array(chunk));
+    if (chunk instanceof ArrayBuffer || (typeof SharedArrayBuffer !== 'undefined' && chunk instanceof SharedArrayBuffer)) return this.bytes(new Uint8Array(chunk));
     if (chunk instanceof Uint8Array || chunk instanceof DataView) return this.bytes(new Uint8Array(chunk.buffer, chunk.byteOffset, chunk.byteLength));
     throw new TypeError(`${this.where} takes a Float32Array (samples in -1..1), an Int16Array, or the bytes of 16-bit little-endian PCM `
-      + `(an ArrayBuffer, Uint8Array or DataView); it was given ${describe(chunk)}`);
+      + `(an ArrayBuffer, Uint8Array or DataView); it was given ${describe(chunk, 'base64 text? decode it to bytes first')}`);
   }
 
   /** Bytes of 16-bit little-endian PCM; a byte left over waits for the next piece. */
@@ -63,18 +63,19 @@ function finite(samples: Float32Array, where: string): Float32Array {
   return samples;
 }
 
-function describe(value: unknown): string {
+/** What `value` is, for a message; `ifString`: what a string there probably is. */
+function describe(value: unknown, ifString: string): string {
   if (value === null || value === undefined) return String(value);
-  if (typeof value === 'string') return 'a string (base64 text? decode it to bytes first)';
-  if (typeof value !== 'object') return `a ${typeof value}`;
-  return `a ${(value as object).constructor?.name ?? 'object'}`;
+  if (typeof value === 'string') return `a string (${ifString})`;
+  const name = typeof value === 'object' ? (value as object).constructor?.name ?? 'object' : typeof value;
+  return `${/^[aeiou]/i.test(name) ? 'an' : 'a'} ${name}`;
 }
 
 /** A stream's sample rate, checked: a whole number of Hz that an AudioBuffer can hold. */
 export function checkedStreamRate(rate: unknown, where: string): number {
   if (typeof rate !== 'number' || !Number.isInteger(rate) || rate < MIN_STREAM_RATE || rate > MAX_STREAM_RATE) {
     throw new RangeError(`${where}: sampleRate must be the stream's rate in Hz, a whole number from ${MIN_STREAM_RATE} to ${MAX_STREAM_RATE} `
-      + `(24000 for most speech services' 16-bit PCM); it was ${typeof rate === 'number' ? rate : describe(rate)}`);
+      + `(24000 for most speech services' 16-bit PCM); it was ${typeof rate === 'number' ? rate : describe(rate, `${JSON.stringify(rate)}: give a number`)}`);
   }
   return rate;
 }

@@ -24,15 +24,26 @@ export const STREAM_MARGIN_SECONDS = 0.15;
  */
 export const FIRST_PIECE_SECONDS = 0.25;
 
-export interface SpeechStreamOptions {
-  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM), for pieces the page writes. */
-  sampleRate?: number;
+/** speakStream()'s options: pieces the page writes at `sampleRate`, or a MediaStream followed (`media`). */
+export type SpeechStreamOptions = WrittenSpeechOptions | MediaSpeechOptions;
+
+export interface WrittenSpeechOptions extends StreamDelayOption {
+  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM). */
+  sampleRate: number;
+  media?: undefined;
+}
+
+export interface MediaSpeechOptions extends StreamDelayOption {
   /**
-   * Or a MediaStream to follow instead (a voice agent's WebRTC track): its sound is played, with the face, from the
-   * element (leave it unplayed elsewhere: it would be heard twice) until its audio ends or end() or stop() is called.
-   * Its tracks are left running. No take is kept (a call may last hours).
+   * A MediaStream to follow (a voice agent's WebRTC track): its sound is played, with the face, from the element (leave
+   * it unplayed elsewhere: it would be heard twice) until its audio ends or end() or stop() is called. Its tracks are
+   * left running. No take is kept (a call may last hours).
    */
-  media?: MediaStream;
+  media: MediaStream;
+  sampleRate?: undefined;
+}
+
+export interface StreamDelayOption {
   /**
    * How long after the first piece arrives its sound starts (ms). Default: the model's look-ahead, the first piece's
    * length (at most 0.25 s) and 150 ms to compute in: about 0.36 s for pieces of 0.1 s. Where frames come late all the
@@ -43,7 +54,7 @@ export interface SpeechStreamOptions {
 
 /** speakStream()'s options, checked before the element stops what it does: a bad one throws a TypeError or RangeError. */
 export function checkedStreamOptions(options: SpeechStreamOptions): { sampleRate: number; media: MediaStream | null; delayMs: number | undefined } {
-  const { sampleRate, media, delayMs } = options ?? {};
+  const { sampleRate, media, delayMs } = (options ?? {}) as Partial<WrittenSpeechOptions & MediaSpeechOptions> & { sampleRate?: number; media?: MediaStream };
   if (media !== undefined) {
     const problem = sampleRate === undefined ? mediaProblem(media) : 'give sampleRate (pieces written) or media (a MediaStream), not both';
     if (problem) throw new TypeError(`speakStream: ${problem}`);
@@ -187,12 +198,14 @@ export class SpeechStream {
     const { engine, player } = this.started!;
     if (!this.playback) {
       const delay = this.firstDelay(samples);
+      const playing = (d: number) => this.host.playing(`Playing streamed speech (${Math.round(d * 1000)} ms behind it, ${engine.backend}).`);
       this.playback = new StreamPlayback(player, this.sampleRate, engine.fps, delay, {
         onFrame: (frame, frames, at) => this.host.dispatch(new CustomEvent<FrameDetail>('frame',
           { detail: streamFrameDetail(engine, frame, frames, at, this.playback?.lateFrames ?? 0) })),
+        onDelay: playing, lookAhead: this.session!.lookAheadMs / 1000,
       });
       void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with the player
-      this.host.playing(`Playing streamed speech (${Math.round(delay * 1000)} ms behind it, ${engine.backend}).`);
+      playing(delay);
     }
     let pushed: Promise<void>;
     try {
@@ -228,7 +241,7 @@ export class SpeechStream {
       return this.broken(e as Error);
     }
     if (this.closed) return;
-    if (!this.playback) return this.close(); // nothing was written
+    if (!this.playback) return this.close(); // nothing was written: no take, no `ended` (nothing played)
     this.playback.end();
     await this.playback.done;
     if (!this.playback.playedOut || !this.host.current()) return this.close();

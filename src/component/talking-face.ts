@@ -181,6 +181,7 @@ export class TalkingFaceElement extends ElementBase {
     return (this.speech = new SpeechStream(checked, this.host(gen, signal), (animation, buffer) => {
       if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
       [this.animation, this.computeMs, this.audioSeconds] = [animation, NaN, buffer.duration]; // (no compute time of its own)
+      this.playingStatus = `Playing streamed speech (${buffer.duration.toFixed(1)} s).`; // (recordVideo() plays it again)
       this.stage.player?.load(animation, buffer); // for recordVideo()
     }));
   }

@@ -25,6 +25,13 @@ const FORGET_AFTER = 2 * MAX_DELAY;
 export interface StreamPlaybackOptions {
   /** Called for each frame shown: the stream's frame `frame`, which is `frames`' frame `at`. */
   onFrame?: (frame: number, frames: Frames, at: number) => void;
+  /** Called when the delay grows (its new value, s). */
+  onDelay?: (delay: number) => void;
+  /**
+   * How far past its own time a frame reads the sound (s: the model's look-ahead). A frame computed late only because
+   * that sound came late (the pieces paused: between sentences, a stall) does not make the delay grow.
+   */
+  lookAhead?: number;
 }
 
 export class StreamPlayback {
@@ -44,6 +51,7 @@ export class StreamPlayback {
   private spanDelay = 0; // the span playing: seconds from its first piece's arrival to its sound
   private needed = 0; // the delay the frames of the span playing needed (0: none came late)
   private chunks: { first: number; frames: Frames }[] = [];
+  private arrivals: { end: number; time: number }[] = []; // recent pieces: the sample after each, and when it came
   private computed = 0; // frames [0, computed) have come
   private ended = false;
   private over = false;
@@ -68,7 +76,11 @@ export class StreamPlayback {
     if (this.over || this.ended || samples.length === 0) return;
     const now = this.context.currentTime;
     const follows = this.timeline.follows(now);
-    if (this.needed > this.delay) this.delay = Math.min(MAX_DELAY, this.needed); // and this piece starts a new span
+    this.arrivals.push({ end: this.timeline.samples + this.waiting.reduce((n, w) => n + w.length, 0) + samples.length, time: now });
+    if (this.needed > this.delay) { // and this piece starts a new span
+      this.delay = Math.min(MAX_DELAY, this.needed);
+      this.options.onDelay?.(this.delay);
+    }
     else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
     this.needed = 0;
     if (this.waiting.length === 0) this.waitingSince = now;
@@ -81,10 +93,29 @@ export class StreamPlayback {
     if (this.over || frames.count === 0) return;
     this.chunks.push({ first, frames });
     this.computed = first + frames.count;
-    const due = this.timeline.timeOf(Math.round((first / this.fps) * this.rate));
-    const late = due === null ? 0 : this.context.currentTime - due;
+    const late = this.lateness(first, frames.count);
     if (late > LATE_TOLERANCE) this.needed = Math.max(this.needed, this.spanDelay + late + GROW_MARGIN);
     this.release();
+  }
+
+  /**
+   * How late frames [first, first + count) came, just in, for want of time to compute them: after their sound began,
+   * the sound they read (their look-ahead) having come before. Frames whose sound has not begun, and frames that read
+   * sound which came only after their own had begun (the pieces paused: no delay would have helped), do not count.
+   */
+  private lateness(first: number, count: number): number {
+    const now = this.context.currentTime;
+    const lookAhead = this.options.lookAhead ?? 0;
+    let ready = Infinity; // the earliest time one of them could have been shown in time
+    for (let f = first; f < first + count; f++) {
+      const due = this.timeline.timeOf(Math.round((f / this.fps) * this.rate));
+      if (due === null) continue; // its sound is still to be placed: not late
+      const needs = Math.round((f / this.fps + lookAhead) * this.rate);
+      const came = this.arrivals.find((a) => a.end >= needs)?.time ?? this.arrivals.at(-1)?.time ?? now; // (past the end: the last piece)
+      if (came <= due) ready = Math.min(ready, due); // (else its sound had begun before what it reads came: no delay helps)
+    }
+    while (this.arrivals.length > 1 && this.arrivals[1].end < Math.round((first / this.fps) * this.rate)) this.arrivals.shift();
+    return now - ready; // (-Infinity where none is placed yet: not late)
   }
 
   /** No more pieces, and every frame of them has come: once the last has played, the playback is over. */

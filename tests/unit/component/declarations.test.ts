@@ -24,6 +24,16 @@ describe('the shipped declarations', () => {
       "import { TalkingFaceElement, type FrameDetail } from 'talking-face';",
       "const face = document.createElement('talking-face') as TalkingFaceElement;",
       "face.addEventListener('frame', (e) => console.log((e as CustomEvent<FrameDetail>).detail.frame));",
+      // speakStream(): pieces at a rate, or a MediaStream, never both nor neither; the stream is a type only.
+      "import type { SpeechStream, PcmChunk } from 'talking-face';",
+      "const speech: SpeechStream = face.speakStream({ sampleRate: 24000, delayMs: 300 });",
+      "const piece: PcmChunk = new Int16Array(2400);",
+      "const accepted: boolean = speech.write(piece); speech.end(); void speech.done.then(() => accepted);",
+      "face.speakStream({ media: new MediaStream() });",
+      "// @ts-expect-error: a rate or a MediaStream is needed",
+      "face.speakStream({});",
+      "// @ts-expect-error: not both",
+      "face.speakStream({ sampleRate: 24000, media: new MediaStream() });",
     ].join('\n'));
     writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
       target: 'ES2022', module: 'ESNext', moduleResolution: 'bundler', strict: true, skipLibCheck: false, noEmit: true,

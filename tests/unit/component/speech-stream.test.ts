@@ -100,7 +100,7 @@ const tick = () => new Promise((r) => setTimeout(r, 5));
 describe('checkedStreamOptions', () => {
   it('says what is wrong with the options, before anything is stopped', () => {
     expect(checkedStreamOptions({ sampleRate: 24000 })).toEqual({ sampleRate: 24000, media: null, delayMs: undefined });
-    expect(() => checkedStreamOptions({})).toThrow(/sampleRate must be the stream's rate in Hz/);
+    expect(() => checkedStreamOptions({} as never)).toThrow(/sampleRate must be the stream's rate in Hz/);
     expect(() => checkedStreamOptions(undefined as never)).toThrow(/sampleRate must be/);
     expect(() => checkedStreamOptions({ sampleRate: 24000, delayMs: -1 })).toThrow(/delayMs must be from 0 to 10000 ms; it was -1/);
     expect(() => checkedStreamOptions({ media: {} as MediaStream })).toThrow(/media must be a MediaStream/);

@@ -134,6 +134,27 @@ describe('StreamPlayback', () => {
     expect(FakeContext.last.sources.at(-1)!.at).toBeCloseTo(0.85 + 0.45 + GROW_MARGIN + 0.1, 9); // right after the piece before
   });
 
+  it('does not grow the delay for frames that waited for the sound after a pause (the next sentence), only for slow ones', () => {
+    const { player } = stage();
+    const p = new StreamPlayback(player, RATE, FPS, 0.2, { lookAhead: 0.25 });
+    p.write(new Float32Array(500)); // the first sentence: plays 0.2 .. 0.7
+    p.frames(0, frames(0, 3)); // frames 3 and 4 read 0.25 s past their time: they wait for the next sentence
+    drawAt(1.5);
+    p.write(new Float32Array(500)); // the next sentence, 0.8 s after the sound ran out
+    p.frames(3, frames(3, 5)); // frames 3-4 (their sound long played) and 5-7
+    p.write(new Float32Array(100));
+    expect(p.delay).toBe(0.2);
+    expect(FakeContext.last.sources.map((s) => s.at)).toEqual([0.2, 1.7, 2.2].map((t) => expect.closeTo(t, 9)));
+    // The same frames late with their sound in time: computed slowly. That grows it.
+    const slow = new StreamPlayback(stage().player, RATE, FPS, 0.2, { lookAhead: 0.25 }); // (a player of its own: its clock at 0)
+    slow.write(new Float32Array(1000)); // plays 0.2 .. 1.2
+    slow.frames(0, frames(0, 3));
+    drawAt(0.8); // frame 6's sound
+    slow.frames(3, frames(3, 5)); // frame 3's sound began at 0.5: 0.3 s late, its input in since 0
+    slow.write(new Float32Array(100));
+    expect(slow.delay).toBeCloseTo(0.2 + 0.3 + GROW_MARGIN, 9);
+  });
+
   it('rests the face while the stream has run dry, and plays on with the delay when it comes back', () => {
     const { player, shown, speaking } = stage();
     const p = new StreamPlayback(player, RATE, FPS, 0.2);
