@@ -1,12 +1,10 @@
 /**
  * <talking-face>: the whole thing as one custom element (shadow DOM). docs/embedding.md.
- *
- *   <script type="module" src="/lib/talking-face.js"></script>
- *   <talking-face src="/hello.wav" autoplay></talking-face>
- *
+ *   <script type="module" src="/lib/talking-face.js"></script>  <talking-face src="/hello.wav" autoplay></talking-face>
  * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
- * avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), startMicrophone(), stop(), recordVideo().
- * Events: ready, frame, ended, error (detail.message is written for a person). Instances with the same model and backend share one engine.
+ * avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), speakStream(options),
+ * startMicrophone(), stop(), recordVideo(). Events: ready, frame, ended, error (detail.message is written for a person).
+ * Instances with the same model and backend share one engine.
  */
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
