@@ -17,6 +17,7 @@ import { decodeTemplate } from '../src/template/face-template';
 import { ReferenceDecoder, decoderWeights } from '../src/attention/reference';
 import { FastDecoder } from '../src/attention/fast-decoder';
 import { logMelFrames, logMelFramesMeyda, melFrameCount } from '../src/audio/mel';
+import { StreamResampler } from '../src/audio/resample';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
 import { measureLiveDisplay, printLiveDisplay, type LiveDisplay } from './live-display';
@@ -90,6 +91,8 @@ async function nodeBench(): Promise<Record<string, number | string>> {
   return {
     mel_ms_per_audio_second: time(() => logMelFrames(samples, manifest.audio, 0, K)) / seconds,
     mel_meyda_extract_ms_per_audio_second: time(() => logMelFramesMeyda(samples, manifest.audio, 0, K), 1) / seconds,
+    // speakStream()'s pieces brought to the model's rate, in pieces of 0.1 s: ms per second of audio
+    ...Object.fromEntries([24000, 44100, 48000].map((rate) => [`resample_${rate}_ms_per_audio_second`, resampleMs(rate, manifest.audio.sample_rate, time)])),
     decoder_ms_per_frame: time(() => fast.decode(tokens, poseTok, frames)) / frames,
     decoder_kernel: fast.kernelName,
     // what the engine runs: the vertex tokens made of the hierarchical latents first (decodeLatents)
@@ -97,6 +100,16 @@ async function nodeBench(): Promise<Record<string, number | string>> {
     decoder_js_ms_per_frame: time(() => fastJs.decode(tokens, poseTok, frames)) / frames,
     reference_decoder_ms_per_frame: time(() => reference.decode(tokens, poseTok, 4), 1) / 4,
   };
+}
+
+/** Milliseconds per second of audio to bring a 2 s tone at `from` Hz to `to` Hz, streamed in pieces of 0.1 s. */
+function resampleMs(from: number, to: number, time: (fn: () => void) => number): number {
+  const x = Float32Array.from({ length: 2 * from }, (_, i) => Math.sin(i / 7));
+  const piece = from / 10;
+  return time(() => {
+    const r = new StreamResampler(from, to);
+    for (let at = 0; at < x.length; at += piece) r.push(x.subarray(at, at + piece));
+  }) / 2;
 }
 
 async function main(): Promise<void> {

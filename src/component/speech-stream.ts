@@ -7,7 +7,7 @@
 import type { TalkingFaceEngine } from '../engine/engine';
 import { placeFrames, type Animation, type Frames } from '../engine/frames';
 import type { StreamSession } from '../engine/stream';
-import { StreamResampler } from '../audio/capture';
+import { StreamResampler } from '../audio/resample';
 import { checkedStreamRate, PcmReader, type PcmChunk } from '../audio/pcm';
 import type { Player } from '../player/player';
 import { StreamPlayback } from '../player/stream-playback';

@@ -1,6 +1,6 @@
-/** The streaming resampler behind live capture when the AudioContext cannot run at the model's rate. */
+/** The streaming resampler (src/audio/resample.ts): behind live capture when the AudioContext cannot run at the model's rate, and behind speakStream(). */
 import { describe, expect, it } from 'vitest';
-import { StreamResampler } from '../../../src/audio/capture';
+import { StreamResampler } from '../../../src/audio/resample';
 
 const tone = (hz: number, rate: number, n: number) => Float32Array.from({ length: n }, (_, i) => Math.sin((2 * Math.PI * hz * i) / rate));
 
