@@ -76,6 +76,7 @@ export class SpeechStream {
   private ending = false; // end() waits for a MediaStream's last pieces
   private closed = false;
   private failure: Error | null = null;
+  private readonly delayMs0: number | undefined; // the page's delayMs
   private session: StreamSession | null = null;
   private resampler: StreamResampler | null = null;
   private playback: StreamPlayback | null = null;
@@ -98,8 +99,6 @@ export class SpeechStream {
     host.signal.addEventListener('abort', () => this.close(), { once: true });
     void this.start();
   }
-
-  private readonly delayMs0: number | undefined; // the page's delayMs
 
   /** Whether it may still play (not played out, stopped or failed). */
   get open(): boolean {

@@ -80,8 +80,7 @@ export class StreamPlayback {
     if (this.needed > this.delay) { // and this piece starts a new span
       this.delay = Math.min(MAX_DELAY, this.needed);
       this.options.onDelay?.(this.delay);
-    }
-    else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
+    } else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
     this.needed = 0;
     if (this.waiting.length === 0) this.waitingSince = now;
     this.waiting.push(samples);
