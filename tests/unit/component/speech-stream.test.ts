@@ -3,7 +3,7 @@
  * checked before anything stops, `done` rejected on a failure, a bad piece refused before it is played or animated,
  * the delay read from the first piece, stop() cancelling the engine's work, and the take handed over once played.
  */
-import { afterEach, beforeEach, describe, expect, it } from 'vitest';
+import { beforeEach, describe, expect, it } from 'vitest';
 import { checkedStreamOptions, SpeechStream, STREAM_MARGIN_SECONDS, FIRST_PIECE_SECONDS } from '../../../src/component/speech-stream';
 import type { WorkHost } from '../../../src/component/work-host';
 import type { TalkingFaceEngine } from '../../../src/engine/engine';
@@ -11,50 +11,13 @@ import type { Animation, Frames } from '../../../src/engine/frames';
 import type { Pipeline } from '../../../src/engine/pipeline';
 import { StreamSession } from '../../../src/engine/stream';
 import { Player } from '../../../src/player/player';
+import { drawAt, FakeContext, installAudioClock } from '../helpers/audio-clock';
 
 const RATE = 16000;
 const FPS = 25;
 const LOOK_AHEAD = 1600; // samples: 0.1 s
 
-class FakeContext {
-  static last: FakeContext;
-  currentTime = 0;
-  state = 'running';
-  destination = {};
-  started: number[] = [];
-  constructor() {
-    FakeContext.last = this;
-  }
-  resume() { return Promise.resolve(); }
-  close() { return Promise.resolve(); }
-  createBufferSource() {
-    const started = this.started;
-    return { buffer: null, onended: null, connect() {}, start(at: number) { started.push(at); }, stop() {} };
-  }
-}
-class FakeBuffer {
-  readonly length: number;
-  readonly duration: number;
-  private data: Float32Array;
-  constructor({ length, sampleRate }: { length: number; sampleRate: number }) {
-    [this.length, this.duration, this.data] = [length, length / sampleRate, new Float32Array(length)];
-  }
-  getChannelData() { return this.data; }
-}
-let frameCallbacks: (() => void)[] = [];
-function drawAt(time: number): void {
-  FakeContext.last.currentTime = time;
-  const cbs = frameCallbacks;
-  frameCallbacks = [];
-  for (const cb of cbs) cb();
-}
-beforeEach(() => {
-  Object.assign(globalThis, { AudioContext: FakeContext, AudioBuffer: FakeBuffer,
-    requestAnimationFrame: (cb: () => void) => frameCallbacks.push(cb), cancelAnimationFrame: () => undefined });
-});
-afterEach(() => {
-  frameCallbacks = [];
-});
+beforeEach(installAudioClock);
 
 /** A stand-in engine whose frames carry their index; `pushed` counts the samples its streams received. */
 function standIn(pushed: { samples: number; produced: number }, fail = false): TalkingFaceEngine {
@@ -127,7 +90,7 @@ describe('SpeechStream', () => {
     await tick();
     expect(() => s.write(Float32Array.of(0, 1e13))).toThrow(/sample 1 of the piece is 9999999827968; samples must be finite numbers/);
     expect(() => s.write('text' as never)).toThrow(TypeError);
-    expect([s.seconds, pushed.samples, FakeContext.last?.started.length ?? 0]).toEqual([0, 0, 0]);
+    expect([s.seconds, pushed.samples, FakeContext.last?.sources.length ?? 0]).toEqual([0, 0, 0]);
     expect(s.write(new Float32Array(1600))).toBe(true);
     expect(pushed.samples).toBe(1600);
   });

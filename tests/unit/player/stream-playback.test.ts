@@ -3,58 +3,16 @@
  * piece is scheduled after the one before it, the frame shown is the one whose sound plays, a frame not computed in
  * time is counted late, a stall rests the face, end() plays out, stop() silences at once.
  */
-import { afterEach, beforeEach, describe, expect, it } from 'vitest';
+import { beforeEach, describe, expect, it } from 'vitest';
 import { Player } from '../../../src/player/player';
 import { StreamPlayback, GROW_MARGIN, REST_AFTER_SECONDS } from '../../../src/player/stream-playback';
 import type { Frames } from '../../../src/engine/frames';
+import { drawAt, FakeContext, installAudioClock } from '../helpers/audio-clock';
 
 const RATE = 1000; // the pieces' samples per second
 const FPS = 10;
 
-class FakeContext {
-  static last: FakeContext;
-  currentTime = 0;
-  state = 'running';
-  destination = {};
-  sources: { at: number; length: number; stopped: boolean; onended: (() => void) | null }[] = [];
-  constructor() {
-    FakeContext.last = this;
-  }
-  resume() { return Promise.resolve(); }
-  close() { return Promise.resolve(); }
-  createBufferSource() {
-    const s = { at: NaN, length: 0, stopped: false, onended: null as (() => void) | null, buffer: null as { length: number } | null,
-      connect() {}, start(at: number) { s.at = at; s.length = s.buffer!.length; }, stop() { s.stopped = true; } };
-    this.sources.push(s);
-    return s;
-  }
-}
-class FakeBuffer {
-  readonly length: number;
-  private data: Float32Array;
-  constructor({ length }: { length: number }) {
-    this.length = length;
-    this.data = new Float32Array(length);
-  }
-  getChannelData() { return this.data; }
-}
-
-let callbacks: (() => void)[] = [];
-/** Move the audio clock to `time` and draw one animation frame. */
-function drawAt(time: number): void {
-  FakeContext.last.currentTime = time;
-  const cbs = callbacks;
-  callbacks = [];
-  for (const cb of cbs) cb();
-}
-
-beforeEach(() => {
-  Object.assign(globalThis, { AudioContext: FakeContext, AudioBuffer: FakeBuffer,
-    requestAnimationFrame: (cb: () => void) => callbacks.push(cb), cancelAnimationFrame: () => undefined });
-});
-afterEach(() => {
-  callbacks = [];
-});
+beforeEach(installAudioClock);
 
 /** Frames first .. first + count - 1 of one vertex whose x is the frame's index; speech everywhere unless `quiet`. */
 function frames(first: number, count: number, quiet = false): Frames {
