@@ -63,6 +63,9 @@ export function checkedStreamOptions(options: SpeechStreamOptions): { sampleRate
   return { sampleRate: media ? MEDIA_RATE : checkedStreamRate(sampleRate, 'speakStream'), media: media ?? null, delayMs };
 }
 
+/** What speakStream({ media }) returns: a SpeechStream without write() (its sound comes from the MediaStream). */
+export type MediaSpeechStream = Omit<SpeechStream, 'write'>;
+
 export class SpeechStream {
   /** Resolves once everything written has played (after end()), or on stop(); rejects if the stream failed. */
   readonly done: Promise<void>;
@@ -181,7 +184,7 @@ export class SpeechStream {
     try {
       media.follower = await followMedia(media.stream, (piece) => this.accept(piece), () => this.end());
     } catch (e) {
-      return this.fail(this.host.fail('audio', `the MediaStream's sound could not be followed: ${(e as Error).message}`));
+      return this.lost('audio', `the MediaStream's sound could not be followed: ${(e as Error).message}`);
     }
     if (this.closed || this.ended) void media.follower.stop(); // ended or stopped while the capture started
   }
@@ -266,7 +269,14 @@ export class SpeechStream {
 
   private broken(e: Error): void {
     if (this.closed || !this.host.current()) return;
-    this.fail(this.host.fail('inference', `the streamed speech could not be animated: ${e.message}`));
+    this.lost('inference', `the streamed speech could not be animated: ${e.message}`);
+  }
+
+  /** Failed while it may have begun to play: said, then the element stopped (the face rests; `ended` if the sound had begun). */
+  private lost(stage: 'audio' | 'inference', message: string): void {
+    const failure = this.host.fail(stage, message);
+    this.host.halt();
+    this.fail(failure);
   }
 
   private fail(e: Error): void {

@@ -17,7 +17,7 @@ import { ElementStage } from './stage';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { checkedStreamOptions, SpeechStream, type SpeechStreamOptions } from './speech-stream';
+import { checkedStreamOptions, SpeechStream, type MediaSpeechStream, type SpeechStreamOptions, type WrittenSpeechOptions } from './speech-stream';
 import { listenLive } from './microphone';
 import type { WorkHost } from './work-host';
 import { playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
@@ -167,6 +167,8 @@ export class TalkingFaceElement extends ElementBase {
    * Speech that arrives in pieces (a streaming text-to-speech, a voice agent): write() its PCM as it comes, end() after
    * the last piece; each piece is animated and played, the face in sync, a short delay after it arrives. docs/embedding.md.
    */
+  speakStream(options: WrittenSpeechOptions): SpeechStream;
+  speakStream(options: SpeechStreamOptions): MediaSpeechStream; // following a MediaStream (or either): no write()
   speakStream(options: SpeechStreamOptions): SpeechStream {
     let checked: ReturnType<typeof checkedStreamOptions>;
     try {
@@ -188,7 +190,7 @@ export class TalkingFaceElement extends ElementBase {
   private host(gen: number, signal: AbortSignal): WorkHost {
     return { signal, element: this, engine: unlessAborted(this.load(), signal), player: () => this.stage.player, settled: () => this.stage.settled(),
       current: () => gen === this.generation, status: (text) => this.status.set(text), fail: (stage, message) => this.fail(stage, message),
-      playing: (text) => this.status.set((this.playingStatus = text)), dispatch: (event) => this.dispatchEvent(event) };
+      playing: (text) => this.status.set((this.playingStatus = text)), dispatch: (event) => this.dispatchEvent(event), halt: () => this.halt(false) };
   }
 
   /** Stop what this element does and claim the next generation for new work, which `signal` cancels. */
@@ -305,7 +307,6 @@ export class TalkingFaceElement extends ElementBase {
     this.status.set(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
     this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', { detail: readyDetail(engine, this.avatar?.summary) }));
     const src = this.getAttribute('src');
-    // Both report their failure themselves (fail(): the status line and an `error` event) before rejecting.
     if (!start) return;
     this.autoplayed ||= autoplay;
     if (isOn(this.getAttribute('live'))) void this.startMicrophone().catch(() => undefined); // reported by fail()

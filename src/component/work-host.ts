@@ -21,4 +21,6 @@ export interface WorkHost {
   /** Report a failure (the status line, an `error` event) and return it to reject with. */
   fail(stage: TalkingFaceErrorDetail['stage'], message: string): Error;
   dispatch(event: Event): void;
+  /** Stop the element as stop() does (the sound, the face back to rest, `ended` once it had begun to play), its status line left as it is. */
+  halt(): void;
 }
