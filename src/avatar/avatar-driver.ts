@@ -73,11 +73,12 @@ export class AvatarDriver {
 
   /**
    * Show frame `frame` of a take or a streamed chunk, and start speaking if not yet (blended in over
-   * BLEND_IN_SECONDS by update()). A take made without `blendshapes: true` is refused, saying so.
+   * BLEND_IN_SECONDS by update()); `speaking` false: go back to rest from it (as speakStream's `show` asks at a pause
+   * and at the end). A take made without `blendshapes: true` is refused, saying so.
    */
-  show(frames: DrivenFrames, frame: number): void {
+  show(frames: DrivenFrames, frame: number, speaking = true): void {
     this.apply(frames, frame, 'show');
-    this.setSpeaking(true);
+    this.setSpeaking(speaking);
   }
 
   /**

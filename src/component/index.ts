@@ -5,8 +5,6 @@ import type { TalkingFaceEventMap } from './events';
 export * from '../index';
 export { TalkingFaceElement, DEFAULT_MODEL, type ReadyDetail, type FrameDetail, type TalkingFaceErrorDetail } from './talking-face';
 export { TalkingFaceError, type TalkingFaceEventMap } from './events';
-export type { SpeechStream, MediaSpeechStream, SpeechStreamOptions, WrittenSpeechOptions, MediaSpeechOptions, StreamDelayOption } from './speech-stream';
-export type { PcmChunk } from '../audio/pcm';
 
 /** Define the element under `name` (importing the library defines `talking-face`); nothing where there is no DOM. */
 export function defineTalkingFace(name = 'talking-face'): void {

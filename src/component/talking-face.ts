@@ -17,9 +17,10 @@ import { ElementStage } from './stage';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
-import { checkedStreamOptions, SpeechStream, type MediaSpeechStream, type SpeechStreamOptions, type WrittenSpeechOptions } from './speech-stream';
+import { SpeechStream, type MediaSpeechStream } from '../player/speech-stream';
+import { checkedStreamOptions, type SpeechStreamOptions, type WrittenSpeechOptions } from '../player/stream-options';
 import { listenLive } from './microphone';
-import type { WorkHost } from './work-host';
+import { elementStreamHost, type WorkHost } from './work-host';
 import { playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -97,10 +98,7 @@ export class TalkingFaceElement extends ElementBase {
   connectedCallback(): void {
     if (this.stage.view && this.engine) return; // moved within the page (disconnectedCallback kept everything)
     [this.connected, this.retrying] = [true, false]; // this call shows the face once loaded
-    void this.load().then(
-      () => this.afterLoad(),
-      () => undefined, // deliberate: load() has already reported the failure (status line and `error` event)
-    );
+    void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() has reported the failure (status line, `error` event)
   }
 
   disconnectedCallback(): void {
@@ -165,7 +163,7 @@ export class TalkingFaceElement extends ElementBase {
 
   /**
    * Speech that arrives in pieces (a streaming text-to-speech, a voice agent): write() its PCM as it comes, end() after
-   * the last piece; each piece is animated and played, the face in sync, a short delay after it arrives. docs/embedding.md.
+   * the last; each piece is animated and played, the face in sync, a short delay after it arrives (docs/embedding.md).
    */
   speakStream(options: WrittenSpeechOptions): SpeechStream;
   speakStream(options: SpeechStreamOptions): MediaSpeechStream; // following a MediaStream (or either): no write()
@@ -178,12 +176,12 @@ export class TalkingFaceElement extends ElementBase {
     }
     const { gen, signal } = this.begin();
     const work = this.work;
-    return (this.speech = new SpeechStream(checked, this.host(gen, signal), (animation, buffer) => {
+    return (this.speech = new SpeechStream(checked, elementStreamHost(this.host(gen, signal), ({ animation, buffer }) => {
       if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
       [this.animation, this.computeMs, this.audioSeconds] = [animation, NaN, buffer.duration]; // (no compute time of its own)
       this.playingStatus = `Playing streamed speech (${buffer.duration.toFixed(1)} s).`; // (recordVideo() plays it again)
       this.stage.player?.load(animation, buffer); // for recordVideo()
-    }));
+    })));
   }
 
   /** What work of generation `gen` (stopped by `signal`) is lent: the model, the player, the status line, the events. */

@@ -1,7 +1,9 @@
 /** What <talking-face> lends the work it starts (a stream of speech, the microphone): its model, player, status line and events. */
 import type { TalkingFaceEngine } from '../engine/engine';
 import type { Player } from '../player/player';
-import type { TalkingFaceErrorDetail } from './events';
+import type { StreamHost, StreamTake } from '../player/stream-options';
+import { frameOptions } from './attributes';
+import { streamFrameDetail, type FrameDetail, type TalkingFaceErrorDetail } from './events';
 
 export interface WorkHost {
   /** The engine, once loaded (null: stopped meanwhile; rejects when it cannot be loaded, which the element has reported). */
@@ -23,4 +25,20 @@ export interface WorkHost {
   dispatch(event: Event): void;
   /** Stop the element as stop() does (the sound, the face back to rest, `ended` once it had begun to play), its status line left as it is. */
   halt(): void;
+}
+
+/** What a speakStream() of the element is lent: `host`'s, its frames and end sent as events; `keep`: a take played out. */
+export function elementStreamHost(host: WorkHost, keep: (take: StreamTake) => void): StreamHost {
+  return {
+    engine: host.engine, signal: host.signal, current: host.current, status: host.status, fail: host.fail, halt: host.halt,
+    output: host.settled,
+    streamOptions: () => frameOptions(host.element),
+    playing: (delay, backend) => host.playing(`Playing streamed speech (${Math.round(delay * 1000)} ms behind it, ${backend}).`),
+    frame: (engine, frame, frames, at, lateFrames) => host.dispatch(new CustomEvent<FrameDetail>('frame',
+      { detail: streamFrameDetail(engine, frame, frames, at, lateFrames) })),
+    played: (take) => {
+      if (take) keep(take);
+      host.dispatch(new CustomEvent('ended'));
+    },
+  };
 }

@@ -1,14 +1,13 @@
 /**
- * Streamed speech played with the face in sync. Pieces of sound are scheduled on the player's audio clock in spans
- * (StreamTimeline): a span starts `delay` seconds after its first piece arrived, and not before the frame of its first
- * sound has been computed; the pieces after it play back to back. Each animation frame shows the frame whose sound
+ * Streamed speech played with the face in sync. Pieces of sound are scheduled on the output's audio clock (the
+ * element's Player, or a page's own) in spans (StreamTimeline): a span starts `delay` seconds after its first piece
+ * arrived, and not before the frame of its first sound has been computed; the pieces after it play back to back. Each animation frame shows the frame whose sound
  * is playing. Where the engine falls behind all the same (frames computed after their sound began: a slow device, a
  * busy page), the delay grows by how late they came and the next piece starts a new span that much later: the sound
  * pauses once, and the face is in sync again.
  */
 import type { Frames } from '../engine/frames';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
-import type { Player } from './player';
 import { SCHEDULE_MARGIN, StreamTimeline } from './stream-timeline';
 
 /** A pause in the sound longer than this (s) brings the face back to rest until the sound goes on. */
@@ -21,6 +20,23 @@ export const GROW_MARGIN = 0.1;
 export const MAX_DELAY = 3;
 /** Spans of sound over for longer than this (s) are forgotten: frames that late still count as late. */
 const FORGET_AFTER = 2 * MAX_DELAY;
+
+/**
+ * Where streamed speech plays and shows: the element's Player, or a page's own audio context and avatar
+ * (page-stream.ts). One stream at a time: beginStream() stops the one before.
+ */
+export interface StreamOutput {
+  /** A stream begins (`stop` ends it: called by stop(), or when another begins): the audio context it plays on. */
+  beginStream(stop: () => void): AudioContext;
+  /** Connect a source of the stream's sound to where it is heard. */
+  output(node: AudioNode): void;
+  /** Show frame `f` of `frames`; `speaking` false: the face goes back to rest (a pause in the sound, the end). */
+  showFrame(frames: Frames, f: number, speaking: boolean): void;
+  /** The stream `stop` is over (played out, or stopped). */
+  streamDone(stop: () => void): void;
+  /** Stop the stream playing (its `stop`). */
+  stop(): void;
+}
 
 export interface StreamPlaybackOptions {
   /** Called for each frame shown: the stream's frame `frame`, which is `frames`' frame `at`. */
@@ -63,11 +79,11 @@ export class StreamPlayback {
   private readonly stopper = () => this.close();
 
   /** `rate`: the pieces' sample rate; `fps`: the frames'; `delay`: seconds from a span's first piece arriving to its sound. */
-  constructor(private readonly player: Player, readonly rate: number, private readonly fps: number, public delay: number,
+  constructor(private readonly out: StreamOutput, readonly rate: number, private readonly fps: number, public delay: number,
     private readonly options: StreamPlaybackOptions = {}) {
     this.timeline = new StreamTimeline(rate);
     this.done = new Promise((resolve) => (this.finish = resolve));
-    this.context = player.beginStream(this.stopper);
+    this.context = out.beginStream(this.stopper);
     this.tick = requestAnimationFrame(this.draw);
   }
 
@@ -126,7 +142,7 @@ export class StreamPlayback {
 
   /** Stop the sound now; `done` resolves. */
   stop(): void {
-    if (!this.over) this.player.stop(); // calls close(), as the player's own stop() does (the element's stop())
+    if (!this.over) this.out.stop(); // calls close(), as the output's own stop() does (the element's stop())
   }
 
   private schedule(samples: Float32Array, at: number): void {
@@ -134,7 +150,7 @@ export class StreamPlayback {
     buffer.getChannelData(0).set(samples);
     const source = this.context.createBufferSource();
     source.buffer = buffer;
-    this.player.output(source);
+    this.out.output(source);
     source.onended = () => this.sources.delete(source);
     source.start(at);
     this.sources.add(source);
@@ -186,7 +202,7 @@ export class StreamPlayback {
       s.stop();
     }
     this.sources.clear();
-    this.player.streamDone(this.stopper);
+    this.out.streamDone(this.stopper);
     this.finish();
   }
 
@@ -218,7 +234,7 @@ export class StreamPlayback {
     let k = this.chunks.length - 1;
     while (k > 0 && this.chunks[k].first > f) k--;
     const { first, frames } = this.chunks[k];
-    this.player.showFrame(frames, f - first, sounding && this.spoken(f));
+    this.out.showFrame(frames, f - first, sounding && this.spoken(f));
     if (report) this.options.onFrame?.(f, frames, f - first);
   }
 

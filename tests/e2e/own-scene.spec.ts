@@ -159,3 +159,69 @@ test('a VRM 0.x avatar loaded with @pixiv/three-vrm in the page\'s own scene spe
   // Neither three-vrm nor three.js had anything to say (THREE.Clock, deprecated, warned at each load).
   expect(warnings.filter((w) => !/GPU stall due to ReadPixels/.test(w))).toEqual([]);
 });
+
+test('speech streamed in pieces (speakStream) drives the avatar in the page\'s own scene as it plays; its take is the offline one; Stop rests it', async ({ page }) => {
+  test.setTimeout(180_000);
+  await openExample(page);
+  const JAW = ARKIT_NAMES.indexOf('jawOpen');
+  // Each frame handed to the driver (its jawOpen), and the avatar's jawOpen every ~70 ms with how many had been handed.
+  const watch = () => page.evaluate((jaw) => {
+    const g = globalThis as any;
+    const { state } = g.ownSceneExample;
+    let mesh: any;
+    state.driver.avatar.gltf.scene.traverse((o: any) => { if (o.morphTargetDictionary?.jawOpen !== undefined) mesh = o; });
+    const show = state.driver.show.bind(state.driver);
+    g.handed = [];
+    state.driver.show = (frames: any, f: number, speaking: boolean) => {
+      g.handed.push({ jaw: frames.blendshapes.arkit[f * 52 + jaw], speaking });
+      show(frames, f, speaking);
+    };
+    g.seen = [];
+    g.sampler = setInterval(() => g.seen.push({ jaw: mesh.morphTargetInfluences[mesh.morphTargetDictionary.jawOpen], handed: g.handed.length,
+      full: state.driver.speechWeight === 1 }), 70);
+  }, JAW);
+  await watch();
+  await page.locator('#stream').click();
+  await page.evaluate(() => ((globalThis as any).speech = (globalThis as any).ownSceneExample.state.stream));
+  await expect(page.locator('#log')).toHaveText(/^streamed \d+ frames, \d+ ms behind the pieces$/, { timeout: 60_000 });
+  const r = await page.evaluate(() => {
+    const g = globalThis as any;
+    clearInterval(g.sampler);
+    const { take } = g.ownSceneExample.state, streamed = g.speech.take.animation;
+    let pose = 0, arkit = 0;
+    for (let i = 0; i < take.pose.length; i++) pose = Math.max(pose, Math.abs(take.pose[i] - streamed.pose[i]));
+    for (let i = 0; i < take.blendshapes.arkit.length; i++) arkit = Math.max(arkit, Math.abs(take.blendshapes.arkit[i] - streamed.blendshapes.arkit[i]));
+    return { frames: [take.frames, streamed.frames], pose, arkit, handed: g.handed, seen: g.seen, log: document.getElementById('log')!.textContent };
+  });
+  console.log(`streamed to the page's avatar: ${r.log}; ${r.handed.length} frames shown; largest difference from the offline take: `
+    + `pose ${r.pose.toExponential(1)}, ARKit weights ${r.arkit.toExponential(1)}`);
+  expect(r.frames[1]).toBe(r.frames[0]);
+  expect(r.pose).toBeLessThan(1e-4);
+  expect(r.arkit).toBeLessThan(1e-3);
+  expect(r.handed.length).toBeGreaterThan(10);
+  expect(r.handed.at(-1).speaking, 'the last frame at rest').toBe(false);
+  // At full weight the avatar shows the frame the stream handed over last (or the one before: the page's loop may
+  // draw before the stream's animation frame hands over the next).
+  const full = r.seen.filter((s: { full: boolean; handed: number }) => s.full && s.handed >= 2);
+  expect(full.length).toBeGreaterThanOrEqual(8);
+  for (const s of full) {
+    const near = [r.handed[s.handed - 1].jaw, r.handed[s.handed - 2].jaw].some((w: number) => Math.abs(w - s.jaw) < 1e-6);
+    expect(near, `jawOpen ${s.jaw} after ${s.handed} frames handed`).toBe(true);
+  }
+  const jaws = full.map((s: { jaw: number }) => s.jaw);
+  expect(Math.max(...jaws) - Math.min(...jaws), 'jawOpen moves').toBeGreaterThan(0.15);
+  await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
+
+  // Stopped mid-stream: the sound stops, one last frame at rest, nothing shown after it; the avatar back to rest.
+  await watch();
+  await page.locator('#stream').click();
+  await expect.poll(() => page.evaluate(() => (globalThis as any).handed.length), { timeout: 30_000 }).toBeGreaterThan(5);
+  await page.locator('#stop').click();
+  await expect(page.locator('#log')).toHaveText('stopped streaming');
+  const atStop = await page.evaluate(() => (globalThis as any).handed.length);
+  await page.waitForTimeout(1000);
+  const after = await page.evaluate(() => (globalThis as any).handed.slice(-2));
+  expect(await page.evaluate(() => (globalThis as any).handed.length)).toBe(atStop);
+  expect(after[1].speaking).toBe(false);
+  await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
+});

@@ -1,20 +1,18 @@
 /**
- * <talking-face>'s speakStream(): speech that arrives in pieces (a streaming text-to-speech, a voice agent's socket)
- * animated and played as it comes, the face in sync with the sound. Each piece is played a fixed delay after the
- * first arrived (player/stream-playback.ts) and pushed, at the model's rate, into the engine's stream, whose frames
- * are ready before their sound plays. docs/embedding.md, "Streamed speech".
+ * Speech that arrives in pieces (a streaming text-to-speech, a voice agent's socket or WebRTC track) animated and
+ * played as it comes, the face in sync with the sound: <talking-face>'s speakStream(), and speakStream(engine, ...)
+ * for a page's own scene (page-stream.ts). Each piece is played a fixed delay after the first arrived
+ * (stream-playback.ts) and pushed, at the model's rate, into the engine's stream, whose frames are ready before their
+ * sound plays. docs/embedding.md, "Streamed speech".
  */
 import type { TalkingFaceEngine } from '../engine/engine';
-import { placeFrames, type Animation, type Frames } from '../engine/frames';
+import { placeFrames, type Frames } from '../engine/frames';
 import type { StreamSession } from '../engine/stream';
 import { StreamResampler } from '../audio/resample';
-import { checkedStreamRate, PcmReader, type PcmChunk } from '../audio/pcm';
-import type { Player } from '../player/player';
-import { StreamPlayback } from '../player/stream-playback';
-import { frameOptions } from './attributes';
-import { followMedia, mediaProblem, MEDIA_PIECE_SECONDS, MEDIA_RATE, type MediaFollower } from './media-speech';
-import { streamFrameDetail, type FrameDetail } from './events';
-import type { WorkHost } from './work-host';
+import { PcmReader, type PcmChunk } from '../audio/pcm';
+import { StreamPlayback, type StreamOutput } from './stream-playback';
+import { followMedia, MEDIA_PIECE_SECONDS, type MediaFollower } from '../audio/media-speech';
+import type { checkedStreamOptions, StreamHost, StreamTake } from './stream-options';
 
 /** What the delay holds besides the model's look-ahead and the first piece: time to compute the frames (s). */
 export const STREAM_MARGIN_SECONDS = 0.15;
@@ -24,45 +22,6 @@ export const STREAM_MARGIN_SECONDS = 0.15;
  */
 export const FIRST_PIECE_SECONDS = 0.25;
 
-/** speakStream()'s options: pieces the page writes at `sampleRate`, or a MediaStream followed (`media`). */
-export type SpeechStreamOptions = WrittenSpeechOptions | MediaSpeechOptions;
-
-export interface WrittenSpeechOptions extends StreamDelayOption {
-  /** The pieces' sample rate in Hz (24000 for most speech services' 16-bit PCM). */
-  sampleRate: number;
-  media?: undefined;
-}
-
-export interface MediaSpeechOptions extends StreamDelayOption {
-  /**
-   * A MediaStream to follow (a voice agent's WebRTC track): its sound is played, with the face, from the element (leave
-   * it unplayed elsewhere: it would be heard twice) until its audio ends or end() or stop() is called. Its tracks are
-   * left running. No take is kept (a call may last hours).
-   */
-  media: MediaStream;
-  sampleRate?: undefined;
-}
-
-export interface StreamDelayOption {
-  /**
-   * How long after the first piece arrives its sound starts (ms). Default: the model's look-ahead, the first piece's
-   * length (at most 0.25 s) and 150 ms to compute in: about 0.36 s for pieces of 0.1 s. Where frames come late all the
-   * same (a slow device, a busy page) it grows by itself, at the cost of a pause in the sound.
-   */
-  delayMs?: number;
-}
-
-/** speakStream()'s options, checked before the element stops what it does: a bad one throws a TypeError or RangeError. */
-export function checkedStreamOptions(options: SpeechStreamOptions): { sampleRate: number; media: MediaStream | null; delayMs: number | undefined } {
-  const { sampleRate, media, delayMs } = (options ?? {}) as Partial<WrittenSpeechOptions & MediaSpeechOptions> & { sampleRate?: number; media?: MediaStream };
-  if (media !== undefined) {
-    const problem = sampleRate === undefined ? mediaProblem(media) : 'give sampleRate (pieces written) or media (a MediaStream), not both';
-    if (problem) throw new TypeError(`speakStream: ${problem}`);
-  }
-  if (delayMs !== undefined && !(delayMs >= 0 && delayMs <= 10000)) throw new RangeError(`speakStream: delayMs must be from 0 to 10000 ms; it was ${delayMs}`);
-  return { sampleRate: media ? MEDIA_RATE : checkedStreamRate(sampleRate, 'speakStream'), media: media ?? null, delayMs };
-}
-
 /** What speakStream({ media }) returns: a SpeechStream without write() (its sound comes from the MediaStream). */
 export type MediaSpeechStream = Omit<SpeechStream, 'write'>;
 
@@ -70,6 +29,8 @@ export class SpeechStream {
   /** Resolves once everything written has played (after end()), or on stop(); rejects if the stream failed. */
   readonly done: Promise<void>;
   readonly sampleRate: number;
+  /** The whole speech once it has played out (not for a MediaStream's); null until then. */
+  take: StreamTake | null = null;
   private readonly reader = new PcmReader('SpeechStream.write');
   private pieces: Float32Array[] = [];
   private pending: Float32Array[] = []; // written before the model and the face were there
@@ -83,17 +44,13 @@ export class SpeechStream {
   private session: StreamSession | null = null;
   private resampler: StreamResampler | null = null;
   private playback: StreamPlayback | null = null;
-  private started: { engine: TalkingFaceEngine; player: Player } | null = null;
+  private started: { engine: TalkingFaceEngine; output: StreamOutput } | null = null;
   private chunks: { first: number; frames: Frames }[] = [];
   private media: { stream: MediaStream; follower: MediaFollower | null } | null = null; // speakStream({ media })
   private settle: { resolve: () => void; reject: (e: Error) => void } = { resolve: () => undefined, reject: () => undefined };
 
-  /**
-   * `options` as checkedStreamOptions gives them; `keep`: called once it has played out, with the whole take (the element
-   * keeps it for currentAnimation and recordVideo).
-   */
-  constructor(options: ReturnType<typeof checkedStreamOptions>, private readonly host: WorkHost,
-    private readonly keep: (animation: Animation, buffer: AudioBuffer) => void) {
+  /** `options` as checkedStreamOptions gives them. */
+  constructor(options: ReturnType<typeof checkedStreamOptions>, private readonly host: StreamHost) {
     this.sampleRate = options.sampleRate;
     if (options.media) this.media = { stream: options.media, follower: null };
     this.delayMs0 = options.delayMs;
@@ -147,6 +104,16 @@ export class SpeechStream {
     return true;
   }
 
+  /** Stop now, as the element's stop() does (the sound stops, the face rests); `done` resolves. */
+  stop(): void {
+    if (this.closed) return;
+    if (this.host.current()) {
+      this.host.halt();
+      this.host.status('Stopped.');
+    }
+    this.close();
+  }
+
   /** No more pieces (a MediaStream is no longer followed): `done` resolves once the last has played. */
   end(): void {
     if (this.closed || this.ended || this.ending) return;
@@ -163,17 +130,17 @@ export class SpeechStream {
   }
 
   private async start(): Promise<void> {
-    let engine: TalkingFaceEngine | null, player: Player | null;
+    let engine: TalkingFaceEngine | null, output: StreamOutput | null;
     try {
       engine = await this.host.engine;
-      player = engine && (await this.host.settled());
+      output = engine && (await this.host.output());
     } catch (e) {
       return this.fail(e as Error); // the model could not be loaded: load() has said so
     }
     if (this.closed || !this.host.current() || !engine) return this.close();
-    if (!player) return this.fail(this.host.fail('avatar', 'there is no face to show the speech on (is the element in the page?)'));
-    this.started = { engine, player };
-    this.session = engine.createStream((first, frames) => this.frames(first, frames), frameOptions(this.host.element));
+    if (!output) return this.fail(this.host.fail('avatar', 'there is no face to show the speech on (is the element in the page?)'));
+    this.started = { engine, output };
+    this.session = engine.createStream((first, frames) => this.frames(first, frames), this.host.streamOptions());
     this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
     for (const p of this.pending.splice(0)) this.feed(p);
     if (this.ended) void this.finish();
@@ -197,16 +164,15 @@ export class SpeechStream {
   }
 
   private feed(samples: Float32Array): void {
-    const { engine, player } = this.started!;
+    const { engine, output } = this.started!;
     if (!this.playback) {
       const delay = this.firstDelay(samples);
-      const playing = (d: number) => this.host.playing(`Playing streamed speech (${Math.round(d * 1000)} ms behind it, ${engine.backend}).`);
-      this.playback = new StreamPlayback(player, this.sampleRate, engine.fps, delay, {
-        onFrame: (frame, frames, at) => this.host.dispatch(new CustomEvent<FrameDetail>('frame',
-          { detail: streamFrameDetail(engine, frame, frames, at, this.playback?.lateFrames ?? 0) })),
+      const playing = (d: number) => this.host.playing(d, engine.backend);
+      this.playback = new StreamPlayback(output, this.sampleRate, engine.fps, delay, {
+        onFrame: (frame, frames, at) => this.host.frame(engine, frame, frames, at, this.playback?.lateFrames ?? 0),
         onDelay: playing, lookAhead: this.session!.lookAheadMs / 1000,
       });
-      void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with the player
+      void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with its output (the element's stop())
       playing(delay);
     }
     let pushed: Promise<void>;
@@ -247,7 +213,7 @@ export class SpeechStream {
     this.playback.end();
     await this.playback.done;
     if (!this.playback.playedOut || !this.host.current()) return this.close();
-    if (this.media || this.chunks.length === 0) return this.over(`Played the stream's speech (${this.seconds.toFixed(1)} s).`);
+    if (this.media || this.chunks.length === 0) return this.over(`Played the stream's speech (${this.seconds.toFixed(1)} s).`, null);
     const total = this.chunks.at(-1)!.first + this.chunks.at(-1)!.frames.count;
     const buffer = new AudioBuffer({ length: this.written, numberOfChannels: 1, sampleRate: this.sampleRate });
     let at = 0;
@@ -256,14 +222,14 @@ export class SpeechStream {
       at += p.length;
     }
     this.pieces = [];
-    this.keep(placeFrames(this.chunks, total, this.started!.engine.fps), buffer);
-    this.over(`Played streamed speech (${buffer.duration.toFixed(1)} s${this.playback.lateFrames ? `; ${this.playback.lateFrames} frames came late` : ''}).`);
+    this.take = { animation: placeFrames(this.chunks, total, this.started!.engine.fps), buffer };
+    this.over(`Played streamed speech (${buffer.duration.toFixed(1)} s${this.playback.lateFrames ? `; ${this.playback.lateFrames} frames came late` : ''}).`, this.take);
   }
 
-  /** Played out: say so, send `ended`, settle `done`. */
-  private over(status: string): void {
+  /** Played out: say so, hand the take over (the element sends `ended`), settle `done`. */
+  private over(status: string, take: StreamTake | null): void {
     this.host.status(status);
-    this.host.dispatch(new CustomEvent('ended'));
+    this.host.played(take);
     this.close();
   }
 
