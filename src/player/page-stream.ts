@@ -16,7 +16,10 @@ export interface PageStreamOptions {
    * false: back to rest (a pause in the sound, the end, stop()). AvatarDriver's show(frames, frame, speaking) takes it.
    */
   show: (frames: Frames, frame: number, speaking: boolean) => void;
-  /** The audio context the sound plays on (default: one the library makes; resume it from a click: autoplay rules). */
+  /**
+   * The audio context the sound plays on (default: one the library makes). Make or resume it in a click (autoplay
+   * rules): while it is suspended nothing plays, no frame is shown and `done` waits.
+   */
   context?: AudioContext;
   /** Where the sound goes (default: the context's destination). */
   destination?: AudioNode;
@@ -40,6 +43,7 @@ export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOp
   if (typeof (engine as Partial<TalkingFaceEngine> | null)?.createStream !== 'function') throw new TypeError('speakStream: the first argument must be a TalkingFaceEngine (await TalkingFaceEngine.load())');
   if (typeof show !== 'function') throw new TypeError('speakStream: options.show must be a function (frames, frame, speaking) => ...: it shows each frame on your avatar');
   if (context !== undefined && !(context instanceof AudioContext)) throw new TypeError('speakStream: options.context must be an AudioContext');
+  if (context?.state === 'closed') throw new TypeError('speakStream: options.context is closed: nothing can play on it');
   if (destination !== undefined && (!(destination instanceof AudioNode) || (context && destination.context !== context))) {
     throw new TypeError('speakStream: options.destination must be an AudioNode of options.context');
   }
