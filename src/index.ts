@@ -11,7 +11,7 @@ export { DEFAULT_CHUNK_FRAMES } from './engine/pipeline';
 export type { Backend, EngineOptions, AnimateOptions, Animation, Frames, StageTimes } from './engine/engine';
 export { LiveSession, type LiveOptions } from './engine/live';
 export { decodeAudio, levels, AudioDecodeError, SILENT_PEAK, type DecodedAudio } from './audio/decode';
-export { openMicrophone, AudioCapture, MicrophoneError, type CaptureOptions } from './audio/capture';
+export { openMicrophone, listMicrophones, AudioCapture, MicrophoneError, type CaptureOptions, type Microphone } from './audio/capture';
 export { StreamResampler } from './audio/resample';
 export { speakStream, type PageStreamOptions } from './player/page-stream';
 export type { SpeechStream, MediaSpeechStream } from './player/speech-stream';

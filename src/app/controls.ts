@@ -7,6 +7,7 @@ export const ui = {
   canvas: $<HTMLCanvasElement>('face-canvas'),
   fileInput: $<HTMLInputElement>('file-input'),
   recordButton: $<HTMLButtonElement>('record-button'),
+  microphoneSelect: $<HTMLSelectElement>('microphone-select'),
   cancelButton: $<HTMLButtonElement>('cancel-button'),
   backendSelect: $<HTMLSelectElement>('backend-select'),
   playButton: $<HTMLButtonElement>('play-button'),
@@ -46,13 +47,15 @@ export interface ControlsState { take: boolean; busy: boolean; headRedraw: boole
 /**
  * Which controls work now. Playing, scrubbing and exporting need a take, and not the microphone driving the face
  * (recording, or its take being finished); the head's controls redraw the take, so not while another clip is being
- * animated (it would replace it); Record not while a clip is animated; Cancel only then.
+ * animated (it would replace it); Record not while a clip is animated; Cancel only then; the microphone's choice
+ * not while one is recording.
  */
 export function enableControls(s: ControlsState): void {
   const playable = s.take && !s.recording;
   for (const b of [ui.playButton, ui.exportVideoButton, ui.exportGlbButton, ui.exportRawButton, ui.scrub]) b.disabled = !playable;
   ui.headRerollButton.disabled = ui.headScale.disabled = !playable || !s.headMotion || (s.busy && !s.headRedraw);
   ui.recordButton.disabled = s.busy && !s.recording; // while a take is finished it keeps the focus (aria-disabled)
+  ui.microphoneSelect.disabled = s.recording;
   // Cancel hides once the work ends: its focus goes to what comes next, not to the page's start.
   if (!s.busy && document.activeElement === ui.cancelButton) (playable ? ui.playButton : ui.recordButton).focus();
   ui.cancelButton.hidden = !s.busy;

@@ -12,6 +12,7 @@ import { Player } from '../player/player';
 import { audioNotes } from '../player/audio-notes';
 import { TakeView, animateAudio, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
+import { MicrophoneChoice } from './microphone-choice';
 import { fetchSample, fillSampleSelect, markSample, type SampleIndex } from './samples';
 import { setupDetails, decoderDetails, switchBackend, takeDetails, bindDetailsPanel } from './details';
 import { exportGlb, inspectGlb } from './export-glb';
@@ -26,17 +27,16 @@ const FACE_WAITS_MS = 300;
 
 let view: FaceView, player: Player, takeView: TakeView;
 let engine: TalkingFaceEngine | null = null;
-let autoBackend: Backend = 'cpu';
-let take: Take | null = null;
+let autoBackend: Backend = 'cpu', take: Take | null = null;
 let sampleIndex: SampleIndex | null = null;
 let busy: AbortController | null = null;
-let recording: Recording | null = null;
+let recording: Recording | null = null, recordPending = false;
 let finishing = false; // a recording's take being finished
 let headRedraw = false; // the clip being animated is the take's head drawn again
 let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
 /** The current take's most important note about its audio (silent, no speech, clipped, short), or ''. */
 let takeNote = '';
-let recordPending = false;
+const microphones = new MicrophoneChoice(ui.microphoneSelect);
 
 function publish(): void {
   Object.assign(globalThis, { talkingFace: {
@@ -234,7 +234,7 @@ async function toggleRecording(): Promise<void> {
 async function startRecording(e: TalkingFaceEngine): Promise<void> {
   stopPlayback();
   try {
-    const r = await Recording.start(e, (f) => player.showLive(f, e.fps), (err) => tell(`Live animation stopped: ${err.message}`, true));
+    const r = await Recording.start(e, () => microphones.open(), (f) => player.showLive(f, e.fps), (err) => tell(`Live animation stopped: ${err.message}`, true));
     stopPlayback(); // played while the microphone opened
     recording = r;
     refreshControls();
@@ -319,8 +319,7 @@ bindControls({
   redrawHead: redrawTakeHead,
 });
 
-bindDetailsPanel();
-bindKeys({ escape, hasTake: () => take !== null, togglePlay, step: (delta) => showFrame(player.current + delta), view: () => view ?? null }); // null until drawn
+bindDetailsPanel(), bindKeys({ escape, hasTake: () => take !== null, togglePlay, step: (delta) => showFrame(player.current + delta), view: () => view ?? null }); // null until drawn
 for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
 
 start().catch((e: Error) => {

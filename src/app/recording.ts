@@ -6,7 +6,6 @@
 import type { TalkingFaceEngine, Animation, Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { placeFrames } from '../engine/frames';
-import { openMicrophone } from '../audio/capture';
 
 export interface FinishedTake {
   animation: Animation;
@@ -24,9 +23,9 @@ export class Recording {
 
   private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
 
-  /** Open the microphone and animate it live; `onFrames` shows each chunk, `onError` reports a failure. */
-  static async start(engine: TalkingFaceEngine, onFrames: (frames: Frames) => void, onError: (error: Error) => void): Promise<Recording> {
-    const media = await openMicrophone();
+  /** Open the microphone (`open`) and animate it live; `onFrames` shows each chunk, `onError` reports a failure. */
+  static async start(engine: TalkingFaceEngine, open: () => Promise<MediaStream>, onFrames: (frames: Frames) => void, onError: (error: Error) => void): Promise<Recording> {
+    const media = await open();
     engine.resetTimes();
     let recording: Recording | null = null;
     const pending: { first: number; frames: Frames }[] = [];

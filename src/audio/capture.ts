@@ -24,8 +24,33 @@ function frameAllowsMicrophone(): boolean {
   return policy?.allowsFeature('microphone') ?? true;
 }
 
-/** getUserMedia with messages a person can act on. */
-export async function openMicrophone(): Promise<MediaStream> {
+/** An audio input the page may open (listMicrophones()). */
+export interface Microphone {
+  /** What openMicrophone() takes to open this one (stable for this site until the person clears its data). */
+  deviceId: string;
+  /** Its name, or "Microphone N" where the browser gives none. */
+  label: string;
+}
+
+/**
+ * The audio inputs, as the browser lists them (its "default" and "communications" entries, which follow the
+ * system's choice, included). Empty where the page cannot list devices, and where the browser hides them until the
+ * page has been allowed a microphone (it then lists at most one, without an id).
+ */
+export async function listMicrophones(): Promise<Microphone[]> {
+  const devices = await globalThis.navigator?.mediaDevices?.enumerateDevices?.().catch(() => []) ?? []; // (a page that may not list them: none)
+  return devices.filter((d) => d.kind === 'audioinput' && d.deviceId)
+    .map((d, i) => ({ deviceId: d.deviceId, label: d.label || `Microphone ${i + 1}` }));
+}
+
+/**
+ * getUserMedia with messages a person can act on: the system's default microphone, or the one `deviceId` names
+ * (listMicrophones()), and no other: where it is not connected, a MicrophoneError says so.
+ */
+export async function openMicrophone(deviceId?: string): Promise<MediaStream> {
+  if (deviceId !== undefined && (typeof deviceId !== 'string' || !deviceId)) {
+    throw new MicrophoneError('deviceId must be a microphone\'s id, a non-empty string (listMicrophones() gives them)');
+  }
   if (!globalThis.navigator?.mediaDevices?.getUserMedia) {
     throw new MicrophoneError('this page cannot use a microphone here (it needs a secure context: https or localhost)');
   }
@@ -33,11 +58,13 @@ export async function openMicrophone(): Promise<MediaStream> {
     throw new MicrophoneError('this page is in a frame that is not allowed the microphone: the page that embeds it must give its <iframe> allow="microphone" ' +
       '(and a sandboxed frame allow-same-origin as well); or open an audio file instead');
   }
+  const chosen = deviceId ? { deviceId: { exact: deviceId } } : {};
   try {
-    return await navigator.mediaDevices.getUserMedia({ audio: { channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
+    return await navigator.mediaDevices.getUserMedia({ audio: { ...chosen, channelCount: 1, echoCancellation: false, noiseSuppression: false, autoGainControl: false } });
   } catch (e) {
     const name = (e as DOMException).name;
     if (name === 'NotAllowedError' || name === 'SecurityError') throw new MicrophoneError('microphone access was denied; allow it in the browser (the address bar\'s site settings) and try again, or open an audio file instead');
+    if (deviceId && (name === 'NotFoundError' || name === 'OverconstrainedError')) throw new MicrophoneError('the chosen microphone is not connected; plug it back in, or choose another');
     if (name === 'NotFoundError' || name === 'OverconstrainedError') throw new MicrophoneError('no microphone was found; plug one in, or open an audio file instead');
     if (name === 'NotReadableError' || name === 'AbortError') throw new MicrophoneError('the microphone is in use by another application or could not be started');
     throw new MicrophoneError(`the microphone could not be opened: ${(e as Error).message || name}`);

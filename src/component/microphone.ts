@@ -8,14 +8,15 @@ import type { WorkHost } from './work-host';
 
 /**
  * Open the microphone and animate it live: the session, or null when the work was stopped meanwhile (the microphone
- * then closed again). `lost`: listening failed or lost its sound later. Rejects (reported) if the microphone cannot be used.
+ * then closed again). `lost`: listening failed or lost its sound later; `deviceId`: which microphone (default: the
+ * system's). Rejects (reported) if the microphone cannot be used.
  */
-export async function listenLive(host: WorkHost, lost: (stage: TalkingFaceErrorDetail['stage'], message: string) => void): Promise<LiveSession | null> {
+export async function listenLive(host: WorkHost, lost: (stage: TalkingFaceErrorDetail['stage'], message: string) => void, deviceId?: string): Promise<LiveSession | null> {
   const engine = await host.engine;
   if (!engine || !host.current()) return null; // stopped (or removed) while the model loaded: the microphone stays closed
   let media: MediaStream;
   try {
-    media = await openMicrophone();
+    media = await openMicrophone(deviceId);
   } catch (e) {
     if (!host.current()) return null; // stopped (or removed) while the browser asked: not a failure
     throw host.fail('microphone', (e as Error).message);

@@ -198,10 +198,10 @@ export class TalkingFaceElement extends ElementBase {
     return { gen: this.generation, signal: this.work.signal };
   }
 
-  /** Animate the microphone live. Rejects (and sends an error event) if it is denied or absent. */
-  async startMicrophone(): Promise<void> {
+  /** Animate a microphone live (`deviceId`: listMicrophones()'s; default the system's). Rejects (and sends an error event) if it is denied or absent. */
+  async startMicrophone(options: { deviceId?: string } = {}): Promise<void> {
     const { gen, signal } = this.begin();
-    const live = await listenLive(this.host(gen, signal), (stage, message) => this.lost(stage, message));
+    const live = await listenLive(this.host(gen, signal), (stage, message) => this.lost(stage, message), options?.deviceId);
     if (live && gen !== this.generation) void live.stop(); // stopped as it started: the microphone released
     else if (live) [this.liveSession, this.work] = [live, null];
   }

@@ -9,7 +9,7 @@ import { SPEECH, speechSamples, wav } from './helpers/audio';
  */
 test.use({ launchOptions: fakeMicrophone(SPEECH) });
 
-const WATCHED = ['#face-canvas', '#timeline', '#file-input + span', '#record-button', '#sample-select', '#backend-select',
+const WATCHED = ['#face-canvas', '#timeline', '#file-input + span', '#record-button', '#microphone-select', '#sample-select', '#backend-select',
   '#play-button', '#scrub', '#time-label', '#paint-select', '#export-video', '#export-glb', '#export-raw', '#status', '#details'];
 
 type Boxes = Record<string, { x: number; y: number; width: number; height: number }>;

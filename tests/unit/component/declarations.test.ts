@@ -48,6 +48,12 @@ describe('the shipped declarations', () => {
       "face.speakStream({});",
       "// @ts-expect-error: not both",
       "face.speakStream({ sampleRate: 24000, media: new MediaStream() });",
+      // The microphone: the system's, or one of those listed.
+      "import { listMicrophones, type Microphone } from 'talking-face';",
+      "void listMicrophones().then((inputs: Microphone[]) => face.startMicrophone({ deviceId: inputs[0]?.deviceId }));",
+      "void face.startMicrophone();",
+      "// @ts-expect-error: an id is a string",
+      "void face.startMicrophone({ deviceId: 3 });",
     ].join('\n'));
     writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
       target: 'ES2022', module: 'ESNext', moduleResolution: 'bundler', strict: true, skipLibCheck: false, noEmit: true,
