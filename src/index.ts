@@ -27,6 +27,7 @@ export { applyPose } from './pose/posing';
 export { FastDecoder } from './attention/fast-decoder';
 export { GpuDecoder } from './attention/gpu-decoder';
 export { detectWebGPU } from './gpu/capabilities';
+export { webglAvailable } from './render/software-gl';
 export { loadTemplate, decodeTemplate, MM_PER_UNIT, type FaceTemplate } from './template/face-template';
 export { ARKIT_NAMES, VISEME_NAMES, LIVE_LINK_FACE_COLUMNS, normaliseMorphName, type ArkitName, type VisemeName } from './avatar/names';
 export { arkitBasis, JAW_OPEN_DEGREES, type ArkitBasis } from './avatar/basis';

@@ -12,7 +12,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
 import { GltfAvatar, type AvatarBindOptions } from './gltf-avatar';
 import { AvatarDriver } from './avatar-driver';
-import { pixelRatio, softwareWebGL } from '../render/software-gl';
+import { NO_WEBGL, pixelRatio, softwareWebGL, webglAvailable } from '../render/software-gl';
 import { fetchBody, StalledError } from '../model/fetch-body';
 
 /** About a head's bounding radius in metres (glTF's unit). */
@@ -35,6 +35,7 @@ export class AvatarView {
 
   constructor(private readonly canvas: HTMLCanvasElement, readonly avatar: GltfAvatar) {
     this.driver = new AvatarDriver(avatar, performance.now());
+    if (!webglAvailable()) throw new Error(NO_WEBGL); // plainly, not three.js's "Error creating WebGL context"
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGL(), alpha: false }); // render/software-gl.ts
     this.renderer.setPixelRatio(pixelRatio());
     this.scene.background = new THREE.Color(0x1d2230);

@@ -17,6 +17,11 @@ export interface ReadyDetail {
   threads: { encoders: number; decoder: number };
   /** With the `avatar` attribute: which naming scheme drives it, the names matched, the head bone. */
   avatar?: AvatarSummary;
+  /**
+   * False where nothing is drawn: the browser has no WebGL here (an `error` event, stage 'render', said so just before);
+   * speech still plays and `frame` events still come.
+   */
+  drawn: boolean;
 }
 
 /** With an avatar or the `blendshapes` attribute, also the frame's ARKit weights, visemes and head rotation. */
@@ -95,8 +100,8 @@ export function streamFrameDetail(engine: TalkingFaceEngine, frame: number, fram
   };
 }
 
-/** The `ready` event's detail for `engine`, showing `avatar` (or the model's face: undefined). */
-export function readyDetail(engine: TalkingFaceEngine, avatar: AvatarSummary | undefined): ReadyDetail {
+/** The `ready` event's detail for `engine`, showing `avatar` (or the model's face: undefined), or nothing (`drawn` false). */
+export function readyDetail(engine: TalkingFaceEngine, avatar: AvatarSummary | undefined, drawn = true): ReadyDetail {
   return { backend: engine.backend, reason: engine.backendReason, vertices: engine.template.vertexCount, model: engine.manifest.model.name,
-    threads: { encoders: engine.encoderThreads, decoder: engine.cpuThreads }, avatar };
+    threads: { encoders: engine.encoderThreads, decoder: engine.cpuThreads }, avatar, drawn };
 }

@@ -10,12 +10,16 @@ import { Player, type PlayerOptions } from '../player/player';
 import { newCanvas } from './parts';
 import { cameraKey } from '../render/camera-keys';
 import { recordTake } from '../player/record-video';
+import { SoundOnlyView } from '../player/sound-only-view';
+import { NO_WEBGL, webglAvailable } from '../render/software-gl';
 
 export class ElementStage {
-  view: FaceView | AvatarView | null = null;
+  view: FaceView | AvatarView | SoundOnlyView | null = null;
   player: Player | null = null;
   /** Why the last view could not be made, or null. */
   error: string | null = null;
+  /** Why the face is not drawn (no WebGL here: the speech plays and its frames are reported, nothing is shown), or null. */
+  undrawn: string | null = null;
   private token = {};
   private made: Promise<unknown> = Promise.resolve();
 
@@ -26,7 +30,7 @@ export class ElementStage {
    * Make the view on a fresh canvas (a second WebGL renderer cannot share one: parts.ts) with its player: the avatar
    * at `avatar` (a URL relative to the page) turned by `headBone`, or else the model's face. Resolves true once it is
    * shown, false if superseded meanwhile (drop(), another make(), the element removed); rejects with a message for
-   * a person (kept in `error`).
+   * a person (kept in `error`). Where the page has no WebGL, the view draws nothing (`undrawn` says why).
    */
   async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, bound: { headBone: string | null; facing: '+z' | '-z' | undefined }): Promise<boolean> {
     const token = (this.token = {});
@@ -36,14 +40,15 @@ export class ElementStage {
     this.canvas.replaceWith(canvas);
     this.canvas = canvas;
     if (focused) canvas.focus(); // a keyboard user on the face while it loaded stays on it
-    canvas.addEventListener('keydown', (ev) => cameraKey(ev, canvas === this.canvas ? this.view : null));
+    canvas.addEventListener('keydown', (ev) => cameraKey(ev, canvas === this.canvas && !(this.view instanceof SoundOnlyView) ? this.view : null));
     // Only while its view is shown: a dropped view's context is given up on purpose (dispose), and that is no loss.
     canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.view && this.onContext(true));
     canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.view && this.onContext(false));
-    const made: Promise<FaceView | AvatarView> = avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, bound.headBone, { facing: bound.facing })
+    this.undrawn = webglAvailable() ? null : `${avatar ? 'the avatar' : 'the face'} is not shown: ${NO_WEBGL}`;
+    const made: Promise<FaceView | AvatarView | SoundOnlyView> = this.undrawn ? Promise.resolve(new SoundOnlyView()) : avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, bound.headBone, { facing: bound.facing })
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;
-    let view: FaceView | AvatarView;
+    let view: FaceView | AvatarView | SoundOnlyView;
     try {
       view = await made;
     } catch (e) {
@@ -69,12 +74,13 @@ export class ElementStage {
   /** The take loaded in the player, played from its start and recorded with its sound (player/record-video.ts). */
   recordVideo(fps: number, signal: AbortSignal, onProgress: (frame: number) => void): Promise<Blob> {
     if (!this.view || !this.player?.take) return Promise.reject(new Error('there is no take to record: speak() one first'));
+    if (this.view instanceof SoundOnlyView) return Promise.reject(new Error(this.undrawn ?? 'nothing is drawn'));
     return recordTake(this.canvas, this.view, this.player, fps, signal, onProgress);
   }
 
   /** Stop drawing and playing: the view and its player disposed, a view still loading not shown. */
   drop(): void {
-    [this.token, this.error] = [{}, null];
+    [this.token, this.error, this.undrawn] = [{}, null, null];
     this.player?.dispose();
     this.player = null;
     this.view?.dispose();

@@ -302,8 +302,10 @@ export class TalkingFaceElement extends ElementBase {
     const rest = view instanceof AvatarView ? engine.restArkit().then((w) => view.setRest(w))
       : engine.restFace().then((r) => (view as PlayerView | null)?.setRestFace?.(r));
     rest.catch((e: Error) => this.fail('inference', `the face at rest could not be computed: ${e.message}`));
-    this.status.set(`Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`);
-    this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', { detail: readyDetail(engine, this.avatar?.summary) }));
+    const undrawn = this.stage.undrawn && `${this.stage.undrawn}. Speech still plays, and its frames are reported`;
+    this.status.set(undrawn || `Ready: ${engine.template.vertexCount} vertices, decoder ${engine.backend}.`, Boolean(undrawn));
+    if (undrawn) this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message: undrawn, stage: 'render' } }));
+    this.dispatchEvent(new CustomEvent<ReadyDetail>('ready', { detail: readyDetail(engine, this.avatar?.summary, !undrawn) }));
     const src = this.getAttribute('src');
     if (!start) return;
     this.autoplayed ||= autoplay;

@@ -21,7 +21,7 @@ import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
 import { pickFaceVertex, poseArrows } from './overlays';
-import { pixelRatio, softwareWebGL } from './software-gl';
+import { NO_WEBGL, pixelRatio, softwareWebGL, webglAvailable } from './software-gl';
 
 export interface FaceViewOptions {
   /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
@@ -85,6 +85,7 @@ export class FaceView {
     readonly template: FaceTemplate,
     options: FaceViewOptions = {},
   ) {
+    if (!webglAvailable()) throw new Error(NO_WEBGL); // plainly, not three.js's "Error creating WebGL context"
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: options.antialias ?? !softwareWebGL(), alpha: false });
     this.renderer.setPixelRatio(pixelRatio());
     this.model = new Head(template);
@@ -160,9 +161,7 @@ export class FaceView {
 
   /** The face's vertices for this frame (N x 3, template units): I + O from the model, or any face. */
   setVertices(vertices: Float32Array): void {
-    if (vertices.length !== this.frame.length) {
-      throw new Error(`setVertices: expected ${this.frame.length / 3} vertices, got ${vertices.length / 3}`);
-    }
+    if (vertices.length !== this.frame.length) throw new Error(`setVertices: expected ${this.frame.length / 3} vertices, got ${vertices.length / 3}`);
     this.frame.set(vertices);
     this.hasFrame = true;
     this.compose();

@@ -9,7 +9,9 @@
 /** Renderer names of software rasterisers, as WEBGL_debug_renderer_info gives them (ANGLE wraps them in its own). */
 const SOFTWARE = /SwiftShader|llvmpipe|softpipe|Software Rasterizer|Microsoft Basic Render/i;
 
-let probed: boolean | undefined;
+/** What this page's WebGL is: drawn by a GPU, in software, or not there at all. */
+type Gl = 'gpu' | 'software' | 'none';
+let probed: Gl | undefined;
 
 /** True where `renderer` (WEBGL_debug_renderer_info's UNMASKED_RENDERER_WEBGL) names a software rasteriser. */
 export function isSoftwareRenderer(renderer: string): boolean {
@@ -21,20 +23,30 @@ export function isSoftwareRenderer(renderer: string): boolean {
  * (about 20 ms under SwiftShader). Where the browser does not name its renderer, a GPU is assumed.
  */
 export function softwareWebGL(): boolean {
-  if (probed === undefined) probed = probe();
-  return probed;
+  return (probed ??= probe()) === 'software';
 }
 
-function probe(): boolean {
-  if (typeof document === 'undefined') return false;
+/**
+ * Whether this page can draw 3D at all: false where the browser gives no WebGL (hardware acceleration turned off, a
+ * graphics driver it blocks with no software fallback, a policy); true where there is no document to ask (a server).
+ */
+export function webglAvailable(): boolean {
+  return (probed ??= probe()) !== 'none';
+}
+
+function probe(): Gl {
+  if (typeof document === 'undefined') return 'gpu';
   const canvas = document.createElement('canvas');
   const gl = canvas.getContext('webgl2') ?? canvas.getContext('webgl');
-  if (!gl) return false;
+  if (!gl) return 'none';
   const info = gl.getExtension('WEBGL_debug_renderer_info');
   const renderer = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
   gl.getExtension('WEBGL_lose_context')?.loseContext();
-  return isSoftwareRenderer(renderer);
+  return isSoftwareRenderer(renderer) ? 'software' : 'gpu';
 }
+
+/** What a visitor is told where the face cannot be drawn (webglAvailable() false). */
+export const NO_WEBGL = 'this browser cannot draw 3D here (WebGL is turned off or unavailable): turn on hardware acceleration in its settings, or try another browser';
 
 /**
  * The drawing buffer's pixels per CSS pixel: the screen's (at most 2) on a GPU; 1 where WebGL draws in software, where

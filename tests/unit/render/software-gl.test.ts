@@ -1,6 +1,6 @@
-/** Software WebGL (src/render/software-gl.ts): which renderer names count as a software rasteriser. */
+/** Software WebGL (src/render/software-gl.ts): which renderer names count as a software rasteriser; no WebGL at all. */
 import { afterEach, describe, expect, it, vi } from 'vitest';
-import { isSoftwareRenderer, pixelRatio, softwareWebGL } from '../../../src/render/software-gl';
+import { isSoftwareRenderer, pixelRatio, softwareWebGL, webglAvailable } from '../../../src/render/software-gl';
 
 /** Renderer names as browsers report them (WEBGL_debug_renderer_info), and whether each is software. */
 const NAMES: [string, boolean][] = [
@@ -40,5 +40,15 @@ describe('software WebGL', () => {
     vi.stubGlobal('devicePixelRatio', 2);
     expect(fresh.softwareWebGL()).toBe(true);
     expect(fresh.pixelRatio()).toBe(1);
+    expect(fresh.webglAvailable()).toBe(true);
+  });
+
+  it('tells a page without WebGL (its canvases give no context) from one that has it', async () => {
+    expect(webglAvailable(), 'no document to ask: assumed').toBe(true);
+    vi.stubGlobal('document', { createElement: () => ({ getContext: () => null }) });
+    vi.resetModules();
+    const fresh = await import('../../../src/render/software-gl');
+    expect(fresh.webglAvailable()).toBe(false);
+    expect(fresh.softwareWebGL()).toBe(false);
   });
 });
