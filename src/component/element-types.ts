@@ -17,6 +17,8 @@ export interface TalkingFaceAttributes {
   autoplay?: boolean;
   /** Animate the microphone as soon as the model is ready. */
   live?: boolean;
+  /** Play silently, the face still in sync (the `muted` property; `volume` sets the loudness, 0 to 1). */
+  muted?: boolean;
   'hide-status'?: boolean;
   /** URL of a glTF avatar (.glb, .gltf or .vrm) to drive instead of the built-in face; null: the built-in face. */
   avatar?: string | null;

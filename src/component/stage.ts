@@ -13,6 +13,9 @@ import { recordTake } from '../player/record-video';
 import { SoundOnlyView } from '../player/sound-only-view';
 import { NO_WEBGL, webglAvailable } from '../render/software-gl';
 
+/** What the element says when the browser takes its view's WebGL context. */
+export const CONTEXT_LOST = 'the face can no longer be drawn: the browser took its WebGL context (too many 3D views on the page?); it is drawn again if the browser gives it back';
+
 export class ElementStage {
   view: FaceView | AvatarView | SoundOnlyView | null = null;
   player: Player | null = null;
@@ -20,6 +23,8 @@ export class ElementStage {
   error: string | null = null;
   /** Why the face is not drawn (no WebGL here: the speech plays and its frames are reported, nothing is shown), or null. */
   undrawn: string | null = null;
+  private loudness = 1;
+  private silenced = false;
   private token = {};
   private made: Promise<unknown> = Promise.resolve();
 
@@ -62,7 +67,27 @@ export class ElementStage {
     }
     this.view = view;
     this.player = new Player(view, unitsPerMm, this.events);
+    this.player.volume = this.silenced ? 0 : this.loudness;
     return true;
+  }
+
+  /** How loud the speech plays, 0 to 1 (the element's `volume`), kept for every view made; RangeError outside. */
+  get volume(): number {
+    return this.loudness;
+  }
+  set volume(level: number) {
+    if (typeof level !== 'number' || !(level >= 0 && level <= 1)) throw new RangeError(`volume must be a number from 0 to 1, not ${String(level)}`);
+    this.loudness = level;
+    if (this.player) this.player.volume = this.silenced ? 0 : level;
+  }
+
+  /** Silent, the face still in sync with the sound it would play (the element's `muted`). */
+  get muted(): boolean {
+    return this.silenced;
+  }
+  set muted(on: boolean) {
+    this.silenced = on;
+    if (this.player) this.player.volume = on ? 0 : this.loudness;
   }
 
   /** The player once the view being made is there (an avatar still loading is waited for); null where it failed. */

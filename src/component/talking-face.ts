@@ -13,7 +13,7 @@ import type { LiveSession } from '../engine/live';
 import { avatarAttributes, backendAttribute, frameOptions, isOn, reflect } from './attributes';
 import { makeTake, TakeError, type ElementTake } from './take';
 import { shadowParts, type StatusLine } from './parts';
-import { ElementStage } from './stage';
+import { ElementStage, CONTEXT_LOST } from './stage';
 import { DEFAULT_MANIFEST_URL } from '../model/manifest';
 import { holdEngine, unlessAborted, type EngineHold } from './engines';
 import type { PlayerView } from '../player/player';
@@ -32,7 +32,7 @@ export const DEFAULT_MODEL = DEFAULT_MANIFEST_URL;
 const ElementBase = (typeof HTMLElement === 'undefined' ? class {} : HTMLElement) as typeof HTMLElement;
 
 export class TalkingFaceElement extends ElementBase {
-  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone', 'avatar-facing'];
+  static observedAttributes = ['model', 'template', 'src', 'backend', 'autoplay', 'live', 'avatar', 'avatar-head-bone', 'avatar-facing', 'muted'];
 
   private readonly status: StatusLine;
   private readonly stage: ElementStage;
@@ -64,14 +64,11 @@ export class TalkingFaceElement extends ElementBase {
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
       onBlocked: () => this.status.set('Click or press a key to hear it: the browser plays sound only after a gesture.'),
       onUnblocked: () => this.status.set(this.playingStatus),
-    }, (lost) => (lost ? this.fail('render', 'the face can no longer be drawn: the browser took its WebGL context (too many 3D views on '
-      + 'the page?); it is drawn again if the browser gives it back') : this.status.set('The face is drawn again.')));
+    }, (lost) => (lost ? this.fail('render', CONTEXT_LOST) : this.status.set('The face is drawn again.')));
   }
 
   /** Resolves with the engine once the model is loaded (rejects if it cannot be). */
-  get ready(): Promise<TalkingFaceEngine> {
-    return this.load();
-  }
+  get ready(): Promise<TalkingFaceEngine> { return this.load(); }
 
   /** The decoder's backend in use (null before the model loads); setting it sets the `backend` attribute. */
   get backend(): Backend | null {
@@ -85,6 +82,13 @@ export class TalkingFaceElement extends ElementBase {
   get currentAnimation(): Animation | null {
     return this.animation;
   }
+
+  /** How loud the speech plays, 0 to 1 (default 1), as a media element's `volume`: the face keeps in sync at any volume. */
+  get volume(): number { return this.stage.volume; }
+  set volume(level: number) { this.stage.volume = level; } // a RangeError outside 0-1
+  /** Silent, the face still in sync (a page that plays the sound its own way); reflects the `muted` attribute. */
+  get muted(): boolean { return this.stage.muted; }
+  set muted(on: boolean) { reflect(this, 'muted', on ? '' : null); }
 
   /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
   get avatar(): GltfAvatar | null {
@@ -112,6 +116,7 @@ export class TalkingFaceElement extends ElementBase {
   }
 
   attributeChangedCallback(name: string, old: string | null, value: string | null): void {
+    if (name === 'muted') this.stage.muted = isOn(value); // at once, connected or not
     // Before the first connectedCallback (an upgrade calls this first, for every attribute) that call reads them all.
     if (old === value || !this.isConnected || !this.connected) return;
     if (name === 'model' || name === 'template' || name.startsWith('avatar') || name === 'backend') {
@@ -198,18 +203,18 @@ export class TalkingFaceElement extends ElementBase {
     return { gen: this.generation, signal: this.work.signal };
   }
 
-  /** Animate a microphone live (`deviceId`: listMicrophones()'s; default the system's). Rejects (and sends an error event) if it is denied or absent. */
+  /**
+   * Animate a microphone live (`deviceId`: listMicrophones()'s; default the system's). Rejects (and sends an error event)
+   * if it is denied or absent; one that fails or loses its sound later stops (released, the face at rest), reported.
+   */
   async startMicrophone(options: { deviceId?: string } = {}): Promise<void> {
     const { gen, signal } = this.begin();
-    const live = await listenLive(this.host(gen, signal), (stage, message) => this.lost(stage, message), options?.deviceId);
+    const live = await listenLive(this.host(gen, signal), (stage, message) => (this.fail(stage, message), this.halt(false)), options?.deviceId);
     if (live && gen !== this.generation) void live.stop(); // stopped as it started: the microphone released
     else if (live) [this.liveSession, this.work] = [live, null];
   }
 
-  /**
-   * The last take (speak()) played from its start and recorded, with its sound, as a video (WebM, or MP4 where the browser
-   * records only that) in real time; `signal` cancels (rejecting with its reason). Otherwise rejects with a TalkingFaceError.
-   */
+  /** The last take replayed and recorded with its sound as a video (WebM or MP4) in real time; `signal` cancels. */
   async recordVideo(options: { signal?: AbortSignal; onProgress?: (seconds: number) => void } = {}): Promise<Blob> {
     const { engine, animation } = this;
     if (this.speech?.open) throw this.fail('render', 'streamed speech is playing: record once it has played (its take is then recorded)');
@@ -241,12 +246,6 @@ export class TalkingFaceElement extends ElementBase {
       if (say) this.status.set('Stopped listening.'); // the microphone is released at once; the take's end follows
       void live.stop();
     } else if (say && (wasPlaying || cancelled)) this.status.set('Stopped.');
-  }
-
-  /** Live listening failed or lost its sound: stopped (the microphone released, the face at rest) and reported. */
-  private lost(stage: TalkingFaceErrorDetail['stage'], message: string): void {
-    this.fail(stage, message);
-    this.halt(false);
   }
 
   private load(): Promise<TalkingFaceEngine> {

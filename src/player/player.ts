@@ -63,6 +63,8 @@ export class Player {
   private shape: ((frame: number, unposed: Float32Array) => Float32Array) | null = null;
   private context: AudioContext | null = null;
   private tapNode: MediaStreamAudioDestinationNode | null = null; // where the sound also goes while tapped
+  private gain: GainNode | null = null; // the volume, between the sound and the speakers (not the tap)
+  private level = 1;
   private playing: Playing | null = null;
   private currentFrame = 0;
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
@@ -235,10 +237,24 @@ export class Player {
     if (this.streaming === stop) this.streaming = null;
   }
 
-  /** Where sound that plays goes: the speakers, and the tap while one is open (recordVideo). */
+  /** Where sound that plays goes: the speakers at the volume, and the tap (recordVideo) as it is. */
   output(node: AudioNode): void {
-    node.connect(this.context!.destination);
+    if (!this.gain) {
+      this.gain = this.context!.createGain();
+      this.gain.gain.value = this.level;
+      this.gain.connect(this.context!.destination);
+    }
+    node.connect(this.gain);
     if (this.tapNode) node.connect(this.tapNode);
+  }
+
+  /** How loud the sound plays, 0 (silent: the face keeps its clock) to 1 (as it is); at once, also while it plays. */
+  get volume(): number {
+    return this.level;
+  }
+  set volume(level: number) {
+    this.level = level;
+    if (this.gain) this.gain.gain.value = level;
   }
 
   /** Once `resumed` settles or AUTOPLAY_WAIT_MS pass: a context still suspended waits for a gesture, while `current()`. */
@@ -308,6 +324,6 @@ export class Player {
     this.stop();
     // Deliberate: closing an AudioContext fails only if it is already closed, which is the goal.
     void this.context?.close().catch(() => undefined); // fails only when already closed: the goal
-    this.context = null;
+    [this.context, this.gain] = [null, null];
   }
 }

@@ -54,6 +54,10 @@ describe('the shipped declarations', () => {
       "void face.startMicrophone();",
       "// @ts-expect-error: an id is a string",
       "void face.startMicrophone({ deviceId: 3 });",
+      // Loudness, as a media element's.
+      "face.volume = 0.5; face.muted = !face.muted; const loud: number = face.volume; void loud;",
+      "// @ts-expect-error: a volume is a number",
+      "face.volume = 'loud';",
     ].join('\n'));
     writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ compilerOptions: {
       target: 'ES2022', module: 'ESNext', moduleResolution: 'bundler', strict: true, skipLibCheck: false, noEmit: true,

@@ -22,6 +22,7 @@ export class FakeContext {
   }
   resume() { return Promise.resolve(); }
   close() { return Promise.resolve(); }
+  createGain() { return { gain: { value: 1 }, connect() {} }; }
   createBufferSource() {
     const s = { at: NaN, length: 0, stopped: false, onended: null as (() => void) | null, buffer: null as { length: number } | null,
       connect() {}, start(at: number) { s.at = at; s.length = s.buffer!.length; }, stop() { s.stopped = true; } };

@@ -40,15 +40,21 @@ class FakeContext {
   static last: FakeContext;
   currentTime = 0;
   destination = {};
-  sources: { onended: (() => void) | null; started: number[]; stopped: boolean }[] = [];
+  sources: { onended: (() => void) | null; started: number[]; stopped: boolean; to: unknown[] }[] = [];
+  gains: { gain: { value: number }; to: unknown[] }[] = [];
   constructor() {
     FakeContext.last = this;
   }
   resume() { return Promise.resolve(); }
   close() { return Promise.resolve(); }
+  createGain() {
+    const g = { gain: { value: 1 }, to: [] as unknown[], connect(n: unknown) { g.to.push(n); } };
+    this.gains.push(g);
+    return g;
+  }
   createBufferSource() {
-    const s = { buffer: null, onended: null as (() => void) | null, started: [] as number[], stopped: false,
-      connect() {}, start(...a: number[]) { s.started = a; }, stop() { s.stopped = true; } };
+    const s = { buffer: null, onended: null as (() => void) | null, started: [] as number[], stopped: false, to: [] as unknown[],
+      connect(n: unknown) { s.to.push(n); }, start(...a: number[]) { s.started = a; }, stop() { s.stopped = true; } };
     this.sources.push(s);
     return s;
   }
@@ -178,6 +184,26 @@ describe('Player', () => {
     expect(ctx.sources[1].started[1]).toBe(0);
     expect(ended).toBe(0);
     p.stop();
+  });
+
+  it('plays at its volume: one gain between every sound and the speakers, set before and while it plays', async () => {
+    const { view } = fakeView();
+    const p = new Player(view, 1);
+    p.volume = 0.25; // before any sound: kept
+    p.load(animation(4), {} as AudioBuffer);
+    void p.play();
+    const ctx = FakeContext.last;
+    expect(ctx.gains).toHaveLength(1);
+    expect(ctx.gains[0].gain.value).toBe(0.25);
+    expect(ctx.gains[0].to).toEqual([ctx.destination]);
+    expect(ctx.sources[0].to, 'the sound goes to the gain only').toEqual([ctx.gains[0]]);
+    p.volume = 0; // while it plays: at once
+    expect(ctx.gains[0].gain.value).toBe(0);
+    void p.play(0);
+    expect(ctx.gains, 'one gain for every sound').toHaveLength(1);
+    expect(ctx.sources[1].to).toEqual([ctx.gains[0]]);
+    expect(p.volume).toBe(0);
+    p.dispose();
   });
 
   it('refuses an animation without unposed frames', () => {
