@@ -24,6 +24,9 @@ function frameAllowsMicrophone(): boolean {
   return policy?.allowsFeature('microphone') ?? true;
 }
 
+/** The browser's entries that follow the system's choice rather than name a device. */
+const SYSTEM_ENTRY = /^(default|communications)$/;
+
 /** An audio input the page may open (listMicrophones()). */
 export interface Microphone {
   /** What openMicrophone() takes to open this one (stable for this site until the person clears its data). */
@@ -39,8 +42,15 @@ export interface Microphone {
  */
 export async function listMicrophones(): Promise<Microphone[]> {
   const devices = await globalThis.navigator?.mediaDevices?.enumerateDevices?.().catch(() => []) ?? []; // (a page that may not list them: none)
-  return devices.filter((d) => d.kind === 'audioinput' && d.deviceId)
-    .map((d, i) => ({ deviceId: d.deviceId, label: d.label || `Microphone ${i + 1}` }));
+  const inputs: Microphone[] = [];
+  let place = 0; // among the devices (not the system's default and communications entries)
+  for (const d of devices) {
+    if (d.kind !== 'audioinput' || !d.deviceId) continue;
+    const system = SYSTEM_ENTRY.test(d.deviceId);
+    if (!system) place++;
+    inputs.push({ deviceId: d.deviceId, label: d.label || (system ? d.deviceId : `Microphone ${place}`) });
+  }
+  return inputs;
 }
 
 /**

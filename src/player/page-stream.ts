@@ -4,6 +4,7 @@
  * <talking-face>'s speakStream() for a page that draws its own scene. docs/embedding.md, "Your own avatar in your own
  * three.js scene". Library code of the engine's entry: no element, no renderer.
  */
+import { checkedScale } from '../pose/head-motion';
 import type { TalkingFaceEngine } from '../engine/engine';
 import type { Frames } from '../engine/frames';
 import { SpeechStream, type MediaSpeechStream } from './speech-stream';
@@ -47,8 +48,10 @@ export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOp
   if (destination !== undefined && (!(destination instanceof AudioNode) || (context && destination.context !== context))) {
     throw new TypeError('speakStream: options.destination must be an AudioNode of options.context');
   }
+  checkedScale(headMotionScale); // a RangeError now, not a stream that never starts
   const checked = checkedStreamOptions(options);
   const audio = context ?? (destination?.context as AudioContext | undefined) ?? (shared ??= new AudioContext());
+  if (!(audio instanceof AudioContext) || audio.state === 'closed') throw new TypeError('speakStream: options.destination must belong to an open AudioContext: nothing can play on it');
   const output = new PageOutput(audio, destination ?? audio.destination, show);
   const host: StreamHost = {
     engine: Promise.resolve(engine), output: async () => output, streamOptions: () => ({ blendshapes, headMotionScale }),

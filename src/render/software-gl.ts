@@ -37,7 +37,7 @@ export function webglAvailable(): boolean {
 function probe(): Gl {
   if (typeof document === 'undefined') return 'gpu';
   const canvas = document.createElement('canvas');
-  const gl = canvas.getContext('webgl2') ?? canvas.getContext('webgl');
+  const gl = canvas.getContext('webgl2'); // three.js draws with WebGL 2 only: WebGL 1 alone is none
   if (!gl) return 'none';
   const info = gl.getExtension('WEBGL_debug_renderer_info');
   const renderer = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';

@@ -37,7 +37,7 @@ describe('listMicrophones', () => {
     expect(await listMicrophones()).toEqual([
       { deviceId: 'default', label: 'Default - Headset' },
       { deviceId: 'a1', label: 'Headset' },
-      { deviceId: 'a2', label: 'Microphone 3' },
+      { deviceId: 'a2', label: 'Microphone 2' },
     ]);
   });
 

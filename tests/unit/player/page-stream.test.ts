@@ -87,6 +87,7 @@ describe('speakStream(engine, options)', () => {
     const { context } = pageContext(); // (the clock drawAt moves: the last made)
     expect(() => speakStream(engine, { sampleRate: RATE, show, context, destination: other.destination })).toThrow(/destination must be an AudioNode of options.context/);
     expect(() => speakStream(engine, { sampleRate: 5, show })).toThrow(/sampleRate must be/);
+    expect(() => speakStream(engine, { sampleRate: RATE, show, headMotionScale: 5 })).toThrow(RangeError); // at once: before, a stream that never started
     expect(() => speakStream(engine, { sampleRate: RATE, show, context: closed })).toThrow(/options.context is closed/);
     const reported: unknown[] = [];
     vi.stubGlobal('reportError', (e: unknown) => reported.push(e));
