@@ -4,11 +4,9 @@
  * then the list holds the default and the one chosen on an earlier visit, and it is filled when a recording opens one.
  * A chosen microphone that is listed as gone shows as the default until it comes back.
  */
-import { listMicrophones, openMicrophone } from '../audio/capture';
+import { SYSTEM_ENTRY, listMicrophones, openMicrophone } from '../audio/capture';
 
 const KEY = 'talking-face:microphone';
-/** Entries of the browser's list that follow the system's choice, not a device of their own. */
-const SYSTEM = new Set(['default', 'communications']);
 
 export class MicrophoneChoice {
   private wanted: string;
@@ -41,7 +39,7 @@ export class MicrophoneChoice {
   async refresh(): Promise<void> {
     const inputs = await listMicrophones();
     const system = inputs.find((d) => d.deviceId === 'default');
-    const own = inputs.filter((d) => !SYSTEM.has(d.deviceId));
+    const own = inputs.filter((d) => !SYSTEM_ENTRY.test(d.deviceId));
     const options = [new Option(system ? `default (${system.label.replace(/^Default\s*-\s*/i, '')})` : 'default', '')];
     for (const d of own) options.push(new Option(d.label, d.deviceId));
     // Nothing listed: the browser hides the inputs until the page may use one; the earlier choice is still asked for.

@@ -25,7 +25,7 @@ function frameAllowsMicrophone(): boolean {
 }
 
 /** The browser's entries that follow the system's choice rather than name a device. */
-const SYSTEM_ENTRY = /^(default|communications)$/;
+export const SYSTEM_ENTRY = /^(default|communications)$/;
 
 /** An audio input the page may open (listMicrophones()). */
 export interface Microphone {
