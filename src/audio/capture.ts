@@ -12,6 +12,10 @@ import { StreamResampler } from './resample';
 
 export class MicrophoneError extends Error {
   override name = 'MicrophoneError';
+  /** `notConnected`: the microphone asked for by its id (openMicrophone(deviceId)) is not there. */
+  constructor(message: string, readonly notConnected = false) {
+    super(message);
+  }
 }
 
 /**
@@ -74,7 +78,7 @@ export async function openMicrophone(deviceId?: string): Promise<MediaStream> {
   } catch (e) {
     const name = (e as DOMException).name;
     if (name === 'NotAllowedError' || name === 'SecurityError') throw new MicrophoneError('microphone access was denied; allow it in the browser (the address bar\'s site settings) and try again, or open an audio file instead');
-    if (deviceId && (name === 'NotFoundError' || name === 'OverconstrainedError')) throw new MicrophoneError('the chosen microphone is not connected; plug it back in, or choose another');
+    if (deviceId && (name === 'NotFoundError' || name === 'OverconstrainedError')) throw new MicrophoneError('the chosen microphone is not connected; plug it back in, or choose another', true);
     if (name === 'NotFoundError' || name === 'OverconstrainedError') throw new MicrophoneError('no microphone was found; plug one in, or open an audio file instead');
     if (name === 'NotReadableError' || name === 'AbortError') throw new MicrophoneError('the microphone is in use by another application or could not be started');
     throw new MicrophoneError(`the microphone could not be opened: ${(e as Error).message || name}`);

@@ -5,6 +5,7 @@
  * three.js scene". Library code of the engine's entry: no element, no renderer.
  */
 import { checkedScale } from '../pose/head-motion';
+import { resumeOnGesture } from './autoplay';
 import type { TalkingFaceEngine } from '../engine/engine';
 import type { Frames } from '../engine/frames';
 import { SpeechStream, type MediaSpeechStream } from './speech-stream';
@@ -18,10 +19,13 @@ export interface PageStreamOptions {
    */
   show: (frames: Frames, frame: number, speaking: boolean) => void;
   /**
-   * The audio context the sound plays on (default: one the library makes). Make or resume it in a click (autoplay
-   * rules): while it is suspended nothing plays, no frame is shown and `done` waits.
+   * The audio context the sound plays on (default: one the library makes). Where the browser holds its sound back
+   * (autoplay rules: no click or key press on the page yet), it is resumed at the next one; until then nothing plays,
+   * no frame is shown and `done` waits. Closed while the speech plays: the stream fails (`done` rejects).
    */
   context?: AudioContext;
+  /** Called when the browser holds the sound back until a click or a key press (to ask for one). */
+  onBlocked?: () => void;
   /** Where the sound goes (default: the context's destination). */
   destination?: AudioNode;
   /** Each frame's blend-shape weights, `frames.blendshapes` (default true: what an avatar needs). */
@@ -40,9 +44,10 @@ let shared: AudioContext | null = null; // the default context, made once
 export function speakStream(engine: TalkingFaceEngine, options: WrittenSpeechOptions & PageStreamOptions): SpeechStream;
 export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOptions | MediaSpeechOptions) & PageStreamOptions): MediaSpeechStream;
 export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOptions | MediaSpeechOptions) & PageStreamOptions): SpeechStream {
-  const { show, context, destination, blendshapes = true, headMotionScale } = options ?? {};
+  const { show, context, destination, blendshapes = true, headMotionScale, onBlocked } = options ?? {};
   if (typeof (engine as Partial<TalkingFaceEngine> | null)?.createStream !== 'function') throw new TypeError('speakStream: the first argument must be a TalkingFaceEngine (await TalkingFaceEngine.load())');
   if (typeof show !== 'function') throw new TypeError('speakStream: options.show must be a function (frames, frame, speaking) => ...: it shows each frame on your avatar');
+  if (onBlocked !== undefined && typeof onBlocked !== 'function') throw new TypeError('speakStream: options.onBlocked must be a function');
   if (context !== undefined && !(context instanceof AudioContext)) throw new TypeError('speakStream: options.context must be an AudioContext');
   if (context?.state === 'closed') throw new TypeError('speakStream: options.context is closed: nothing can play on it');
   if (destination !== undefined && (!(destination instanceof AudioNode) || (context && destination.context !== context))) {
@@ -52,7 +57,7 @@ export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOp
   const checked = checkedStreamOptions(options);
   const audio = context ?? (destination?.context as AudioContext | undefined) ?? (shared ??= new AudioContext());
   if (!(audio instanceof AudioContext) || audio.state === 'closed') throw new TypeError('speakStream: options.destination must belong to an open AudioContext: nothing can play on it');
-  const output = new PageOutput(audio, destination ?? audio.destination, show);
+  const output = new PageOutput(audio, destination ?? audio.destination, show, onBlocked);
   const host: StreamHost = {
     engine: Promise.resolve(engine), output: async () => output, streamOptions: () => ({ blendshapes, headMotionScale }),
     current: () => true, signal: new AbortController().signal, // (nothing replaces it: the page stops it with stop())
@@ -67,13 +72,16 @@ export function speakStream(engine: TalkingFaceEngine, options: (WrittenSpeechOp
 class PageOutput implements StreamOutput {
   private stopper: (() => void) | null = null;
   private last: { frames: Frames; f: number } | null = null;
+  private forgetGesture: () => void = () => undefined; // the listeners waiting for a gesture to resume the context
 
   constructor(private readonly context: AudioContext, private readonly destination: AudioNode,
-    private readonly show: PageStreamOptions['show']) {}
+    private readonly show: PageStreamOptions['show'], private readonly onBlocked: (() => void) | undefined) {}
 
   beginStream(stop: () => void): AudioContext {
     this.stopper = stop;
-    void this.context.resume().catch(() => undefined); // deliberate: rejects only on a closed context, where start() throws why
+    const resumed = this.context.resume().catch(() => undefined); // deliberate: rejects only on a closed context, which the playback reports
+    this.forgetGesture();
+    this.forgetGesture = resumeOnGesture(this.context, resumed, () => this.stopper === stop, { onBlocked: this.onBlocked });
     return this.context;
   }
 
@@ -96,12 +104,15 @@ class PageOutput implements StreamOutput {
   }
 
   streamDone(stop: () => void): void {
-    if (this.stopper === stop) this.stopper = null;
+    if (this.stopper !== stop) return;
+    this.stopper = null;
+    this.forgetGesture();
   }
 
   stop(): void {
     const stop = this.stopper;
     this.stopper = null;
+    this.forgetGesture();
     stop?.();
     if (this.last) this.call(this.last.frames, this.last.f, false); // back to rest from where it was
     this.last = null;

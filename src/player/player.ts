@@ -6,6 +6,7 @@
 import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
+import { resumeOnGesture } from './autoplay';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -36,8 +37,6 @@ export interface PlayerOptions {
   onUnblocked?: () => void;
 }
 
-/** How long a resumed audio context may take to run before it counts as held back by the autoplay rules. */
-const AUTOPLAY_WAIT_MS = 300;
 /**
  * Live frames come in batches when the device is slow (a batch per engine run): they are shown one after another,
  * each this fraction of a frame's time after the last (a little faster than real time, so a backlog drains) ...
@@ -45,8 +44,6 @@ const AUTOPLAY_WAIT_MS = 300;
 const LIVE_SPACING = 0.8;
 /** ... and at most this far behind their batch (ms): older ones are dropped rather than shown late. */
 const LIVE_BACKLOG_MS = 250;
-/** The events that count as a person's gesture for the autoplay rules. */
-const GESTURES = ['pointerdown', 'pointerup', 'keydown', 'touchend'] as const;
 
 interface Playing {
   source: AudioBufferSourceNode;
@@ -70,7 +67,7 @@ export class Player {
   private liveQuiet = LIVE_REST_FRAMES; // frames since the live input last held speech
   private liveQueue: { frames: Frames; f: number; due: number }[] = []; // live frames to show, each at its time
   private liveTick = 0; // the animation frame that shows them (0: none asked)
-  private forgetGesture: () => void = () => undefined; // removes the listeners awaitGesture left on the document
+  private forgetGesture: () => void = () => undefined; // removes the listeners watchAutoplay left on the document
   private streaming: (() => void) | null = null; // stops the streamed speech playing (player/stream-playback.ts)
 
   /** `unitsPerMm`: the template's units per mm (the engine's; poses carry mm translations). */
@@ -257,29 +254,10 @@ export class Player {
     if (this.gain) this.gain.gain.value = level;
   }
 
-  /** Once `resumed` settles or AUTOPLAY_WAIT_MS pass: a context still suspended waits for a gesture, while `current()`. */
+  /** A context still suspended once `resumed` settles waits for a gesture (autoplay.ts), while `current()`. */
   private watchAutoplay(resumed: Promise<unknown>, current: () => boolean): void {
-    const context = this.context!;
-    void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
-      if (current() && context.state === 'suspended') this.awaitGesture(context, current);
-    });
-  }
-
-  /** The sound is held back until a gesture: resume the context on the next one (the face follows its clock). */
-  private awaitGesture(context: AudioContext, current: () => boolean): void {
-    this.options.onBlocked?.();
     this.forgetGesture();
-    const forget = (this.forgetGesture = () => {
-      for (const g of GESTURES) document.removeEventListener(g, resume, true);
-      this.forgetGesture = () => undefined;
-    });
-    const resume = () => {
-      void context.resume().then(() => {
-        forget();
-        if (current()) this.options.onUnblocked?.();
-      }, forget); // rejects only on a closed context (the player disposed): nothing left to play
-    };
-    for (const g of GESTURES) document.addEventListener(g, resume, true);
+    this.forgetGesture = resumeOnGesture(this.context!, resumed, current, this.options);
   }
 
   /** Create and resume the audio output now, within a person's gesture, so a take animated later may play (autoplay rules). */

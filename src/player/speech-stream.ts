@@ -139,10 +139,14 @@ export class SpeechStream {
     }
     if (this.closed || !this.host.current() || !engine) return this.close();
     if (!output) return this.fail(this.host.fail('avatar', 'there is no face to show the speech on (is the element in the page?)'));
-    this.started = { engine, output };
-    this.session = engine.createStream((first, frames) => this.frames(first, frames), this.host.streamOptions());
-    this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
-    for (const p of this.pending.splice(0)) this.feed(p);
+    try {
+      this.started = { engine, output };
+      this.session = engine.createStream((first, frames) => this.frames(first, frames), this.host.streamOptions());
+      this.resampler = new StreamResampler(this.sampleRate, engine.manifest.audio.sample_rate);
+      for (const p of this.pending.splice(0)) this.feed(p);
+    } catch (e) {
+      return this.broken(e as Error); // (the options were checked: not expected, but `done` must settle)
+    }
     if (this.ended) void this.finish();
     else if (this.media) await this.follow(this.media);
   }
@@ -172,7 +176,10 @@ export class SpeechStream {
         onFrame: (frame, frames, at) => this.host.frame(engine, frame, frames, at, this.playback?.lateFrames ?? 0),
         onDelay: playing, lookAhead: this.session!.lookAheadMs / 1000,
       });
-      void this.playback.done.then(() => this.playback?.playedOut || this.close()); // stopped with its output (the element's stop())
+      void this.playback.done.then(() => { // stopped with its output (the element's stop()), or its context closed
+        if (this.playback?.contextClosed && !this.closed) this.lost('audio', 'its audio context was closed: nothing more can play on it');
+        else if (!this.playback?.playedOut) this.close();
+      });
       playing(delay);
     }
     let pushed: Promise<void>;

@@ -59,6 +59,8 @@ export class StreamPlayback {
   pauses = 0;
   /** Set when it ended by playing everything out (not by stop()). */
   playedOut = false;
+  /** Set when it ended because its audio context was closed (nothing can play on it any more). */
+  contextClosed = false;
   private readonly timeline: StreamTimeline;
   private readonly context: AudioContext;
   private readonly sources = new Set<AudioBufferSourceNode>();
@@ -84,8 +86,17 @@ export class StreamPlayback {
     this.timeline = new StreamTimeline(rate);
     this.done = new Promise((resolve) => (this.finish = resolve));
     this.context = out.beginStream(this.stopper);
+    this.context.addEventListener('statechange', this.watchContext);
     this.tick = requestAnimationFrame(this.draw);
+    this.watchContext();
   }
+
+  /** A closed context plays nothing more and its clock stops: the playback is over (`contextClosed`). */
+  private readonly watchContext = (): void => {
+    if (this.context.state !== 'closed' || this.over) return;
+    this.contextClosed = true;
+    this.close();
+  };
 
   /** The next piece of sound (mono, at `rate`): it plays after the pieces before it. */
   write(samples: Float32Array): void {
@@ -195,6 +206,7 @@ export class StreamPlayback {
   private close(): void {
     if (this.over) return;
     this.over = true;
+    this.context.removeEventListener('statechange', this.watchContext);
     cancelAnimationFrame(this.tick);
     clearTimeout(this.endTimer);
     for (const s of this.sources) {

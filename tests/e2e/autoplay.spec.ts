@@ -81,3 +81,35 @@ test('an element removed while its clip waits for a gesture leaves no listener o
   await page.evaluate(() => document.getElementById('held')!.remove());
   expect(await listening(), 'pointerdown listeners once the waiting element left').toBe(waiting - 1);
 });
+
+test("speakStream(engine) on the library's own context, begun before any gesture: onBlocked, then it plays on a click and done settles", async ({ page, guard }) => {
+  test.setTimeout(120_000);
+  guard.allowConsoleError(/AudioContext was not allowed to start/);
+  const log: string[] = [];
+  page.on('console', (m) => m.text().startsWith('stream') && log.push(m.text()));
+  // All from an init script: an evaluate() would count as a gesture and let the sound start.
+  await page.addInitScript(() => window.addEventListener('load', async () => {
+    const { speakStream } = await import('/lib/npm/engine.js' as string);
+    const g = globalThis as unknown as { ownSceneExample?: { state: { engine?: unknown } } };
+    while (!g.ownSceneExample?.state.engine) await new Promise((r) => setTimeout(r, 100));
+    let [shown, speaking] = [0, 0];
+    const speech = speakStream(g.ownSceneExample.state.engine, { sampleRate: 16000, onBlocked: () => console.log(`stream blocked after ${shown} frames`),
+      show: (_frames: unknown, _f: number, on: boolean) => (shown++, on && speaking++) });
+    const wav = await (await fetch('/examples/sample.wav')).arrayBuffer();
+    speech.write(new Uint8Array(wav, 44, (wav.byteLength - 44) & ~1)); // 16-bit PCM at 16 kHz after its header
+    speech.end();
+    const expected = Math.round((((wav.byteLength - 44) >> 1) / 16000) * (g.ownSceneExample.state.engine as { fps: number }).fps);
+    speech.done.then(() => console.log(`stream done: ${shown} frames shown, ${speaking} speaking, take ${speech.take?.animation.frames} of ${expected}`),
+      (e: Error) => console.log(`stream failed: ${e.message}`));
+  }));
+  await page.goto('/examples/own-scene.html');
+  await expect.poll(() => log.find((l) => l.startsWith('stream blocked')), { timeout: 60_000 }).toBe('stream blocked after 0 frames');
+  await page.waitForTimeout(1000);
+  expect(log.filter((l) => !l.startsWith('stream blocked')), 'nothing shown, nothing settled while held back').toEqual([]);
+  await page.mouse.click(2, 2); // a gesture anywhere on the page
+  await expect.poll(() => log.find((l) => l.startsWith('stream done') || l.startsWith('stream failed')), { timeout: 60_000 }).toMatch(/^stream done/);
+  const [, shown, speaking, take, expected] = /(\d+) frames shown, (\d+) speaking, take (\d+) of (\d+)/.exec(log.find((l) => l.startsWith('stream done'))!)!.map(Number);
+  expect(take, 'the whole sample played').toBe(expected);
+  expect(shown).toBeGreaterThan(10);
+  expect(speaking).toBeGreaterThan(5);
+});

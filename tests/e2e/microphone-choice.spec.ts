@@ -87,6 +87,22 @@ test('the demo records from the microphone chosen beside Record, and remembers i
   await hiding.close();
 });
 
+test('a remembered microphone that is gone, asked for while the browser hides the list, records from the default', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.addInitScript(() => {
+    localStorage.setItem('talking-face:microphone', 'a-microphone-unplugged-since');
+    navigator.mediaDevices.enumerateDevices = async () => [{ kind: 'audioinput', deviceId: '', label: '', groupId: '' } as MediaDeviceInfo];
+  });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#microphone-select')).toHaveValue('a-microphone-unplugged-since');
+  await record(page);
+  await expect(page.locator('#status')).toContainText('Recording');
+  await stopRecording(page);
+  expect(await opened(page)).toEqual(['default']);
+});
+
 test('the element listens to the microphone it is given, and says so plainly when that one is not connected', async ({ page }) => {
   test.setTimeout(90_000);
   await page.addInitScript(WATCH);

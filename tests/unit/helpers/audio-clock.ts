@@ -10,18 +10,44 @@ export interface FakeSource {
   onended: (() => void) | null;
 }
 
-export class FakeContext {
+export class FakeContext extends EventTarget {
   /** The one made last (undefined until one is made in this test: `installAudioClock` forgets the last test's). */
   static last: FakeContext;
+  /** Set: contexts made from now on start suspended, and resume() waits until allow() (the autoplay rules). */
+  static heldBack = false;
   currentTime = 0;
-  state = 'running';
+  state: AudioContextState = 'running';
   destination = {};
   sources: FakeSource[] = [];
+  resumes = 0; // resume() calls
+  private allowed: () => void = () => undefined;
   constructor() {
+    super();
     FakeContext.last = this;
+    if (FakeContext.heldBack) this.state = 'suspended';
   }
-  resume() { return Promise.resolve(); }
-  close() { return Promise.resolve(); }
+  resume() {
+    this.resumes++;
+    if (this.state !== 'suspended') return this.state === 'closed' ? Promise.reject(new Error('closed')) : Promise.resolve();
+    if (FakeContext.heldBack) return new Promise<void>((resolve) => (this.allowed = resolve));
+    this.setState('running');
+    return Promise.resolve();
+  }
+  /** A gesture lets a held-back context run: a resume() waiting, or the next, resolves. */
+  allow() {
+    FakeContext.heldBack = false;
+    this.setState('running');
+    this.allowed();
+  }
+  close() {
+    this.setState('closed');
+    return Promise.resolve();
+  }
+  private setState(state: AudioContextState) {
+    if (this.state === state) return;
+    this.state = state;
+    this.dispatchEvent(new Event('statechange'));
+  }
   createGain() { return { gain: { value: 1 }, connect() {} }; }
   createBufferSource() {
     const s = { at: NaN, length: 0, stopped: false, onended: null as (() => void) | null, buffer: null as { length: number } | null,
@@ -47,6 +73,7 @@ let callbacks: (() => void)[] = [];
 export function installAudioClock(): void {
   callbacks = [];
   FakeContext.last = undefined as unknown as FakeContext;
+  FakeContext.heldBack = false;
   Object.assign(globalThis, { AudioContext: FakeContext, AudioBuffer: FakeBuffer,
     requestAnimationFrame: (cb: () => void) => callbacks.push(cb), cancelAnimationFrame: () => undefined });
 }

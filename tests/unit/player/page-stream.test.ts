@@ -6,6 +6,7 @@
  */
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
 import { speakStream } from '../../../src/player/page-stream';
+import { AUTOPLAY_WAIT_MS } from '../../../src/player/autoplay';
 import type { Frames } from '../../../src/engine/frames';
 import { drawAt, FakeContext, installAudioClock } from '../helpers/audio-clock';
 import { FPS, RATE, standIn, streamOptions } from '../helpers/stream-engine';
@@ -106,5 +107,54 @@ describe('speakStream(engine, options)', () => {
     expect(calls).toBeGreaterThan(3);
     expect(reported.length).toBe(calls);
     expect(speech.take).not.toBeNull();
+  });
+
+  it('a context the browser holds back plays from the next click: onBlocked says so, and nothing is shown until then', async () => {
+    vi.stubGlobal('document', new EventTarget());
+    FakeContext.heldBack = true;
+    const { context, destination } = pageContext();
+    const shown: boolean[] = [];
+    const onBlocked = vi.fn();
+    const speech = speakStream(standIn({ samples: 0, produced: 0 }), { sampleRate: RATE, context, destination, onBlocked,
+      show: (_frames, _f, speaking) => shown.push(speaking) });
+    speech.write(new Float32Array(RATE / 2));
+    speech.end();
+    await new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS + 50));
+    expect(onBlocked).toHaveBeenCalledTimes(1);
+    expect([context.state, shown.length, speech.open]).toEqual(['suspended', 0, true]);
+    const resumes = FakeContext.last.resumes;
+    document.dispatchEvent(new Event('pointerdown')); // the next click: resumed, by the stream
+    expect(FakeContext.last.resumes).toBe(resumes + 1);
+    FakeContext.last.allow(); // (the browser lets it run)
+    for (let t = 0; t < 2 && speech.open; t += 0.02) {
+      await tick();
+      drawAt(t);
+    }
+    await speech.done;
+    expect(shown.length).toBeGreaterThan(5);
+    vi.unstubAllGlobals();
+  });
+
+  it('a context closed while the speech plays fails the stream: done rejects, the face rests, nothing waits', async () => {
+    const { context, destination } = pageContext();
+    const shown: boolean[] = [];
+    const speech = speakStream(standIn({ samples: 0, produced: 0 }), { sampleRate: RATE, context, destination,
+      show: (_frames, _f, speaking) => shown.push(speaking) });
+    speech.write(new Float32Array(2 * RATE));
+    for (let t = 0; t < 1; t += 0.02) {
+      await tick();
+      drawAt(t);
+    }
+    expect(shown.length).toBeGreaterThan(5);
+    void context.close();
+    await expect(speech.done).rejects.toThrow('speakStream: its audio context was closed: nothing more can play on it');
+    expect(shown.at(-1)).toBe(false);
+    expect(speech.open).toBe(false);
+    // Closed before its first piece (the stream made while it was open): refused as soon as a piece comes.
+    const late = pageContext();
+    const again = speakStream(standIn({ samples: 0, produced: 0 }), { sampleRate: RATE, ...late, show: () => undefined });
+    void late.context.close();
+    expect(again.write(new Float32Array(RATE))).toBe(true); // (taken: the stream starts with the engine)
+    await expect(again.done).rejects.toThrow(/audio context was closed/);
   });
 });

@@ -61,6 +61,19 @@ describe('SpeechStream', () => {
     expect(await settled(t.done)).toBe('rejected: no model');
   });
 
+  it('rejects done where the engine refuses to stream at all (a throw as it starts), the pieces written before it waiting', async () => {
+    const engine = standIn({ samples: 0, produced: 0 });
+    engine.createStream = () => {
+      throw new Error('the engine was disposed');
+    };
+    const refused = host(Promise.resolve(engine));
+    const s = new SpeechStream(checkedStreamOptions({ sampleRate: RATE }), refused.h);
+    s.write(new Float32Array(RATE)); // before the engine is there: it waits
+    expect(await settled(s.done)).toBe('rejected: the streamed speech could not be animated: the engine was disposed');
+    expect(refused.events).toEqual(['error:inference']);
+    expect([s.open, s.write(new Float32Array(10))]).toEqual([false, false]);
+  });
+
   it('refuses a bad piece before it is played or animated, and goes on', async () => {
     const pushed = { samples: 0, produced: 0 };
     const { h } = host(Promise.resolve(standIn(pushed)));
