@@ -129,6 +129,7 @@ export class Pipeline {
    * and between speech. Computed once; the caller must not change them.
    */
   restFrame(): Promise<{ face: Float32Array; pose: Float32Array }> {
+    if (this.disposed) return Promise.reject(new EngineDisposedError()); // (computed before, as when not)
     this.rest ??= (async () => {
       const silence = new Float32Array(this.manifest.audio.sample_rate);
       const F = this.frameCount(silence.length);
@@ -200,6 +201,7 @@ export class Pipeline {
    * gets, the solver's minimiser being unique). Computed once; the caller must not change it.
    */
   restArkit(): Promise<Float32Array> {
+    if (this.disposed) return Promise.reject(new EngineDisposedError());
     this.restWeights ??= this.restFace().then((rest) => {
       const out = new Float32Array(ARKIT_NAMES.length);
       this.avatarWeights.solver.solve(this.offsetsOf(rest), 0, this.avatarWeights.newState(), out);
