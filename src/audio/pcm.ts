@@ -23,7 +23,8 @@ export class PcmReader {
     if (chunk instanceof ArrayBuffer || (typeof SharedArrayBuffer !== 'undefined' && chunk instanceof SharedArrayBuffer)) return this.bytes(new Uint8Array(chunk));
     if (chunk instanceof Uint8Array || chunk instanceof DataView) return this.bytes(new Uint8Array(chunk.buffer, chunk.byteOffset, chunk.byteLength));
     throw new TypeError(`${this.where} takes a Float32Array (samples in -1..1), an Int16Array, or the bytes of 16-bit little-endian PCM `
-      + `(an ArrayBuffer, SharedArrayBuffer, Uint8Array or DataView); it was given ${describe(chunk, 'base64 text? decode it to bytes first')}`);
+      + `(an ArrayBuffer, SharedArrayBuffer, Uint8Array or DataView); it was given ${describe(chunk, 'base64 text? decode it to bytes first')}`
+      + (typeof Blob !== 'undefined' && chunk instanceof Blob ? ` (a WebSocket's message: set socket.binaryType = 'arraybuffer' first)` : ''));
   }
 
   /** Bytes of 16-bit little-endian PCM; a byte left over waits for the next piece. */

@@ -43,6 +43,7 @@ describe('PcmReader', () => {
   it('says what it takes when given something else, and refuses samples that are not finite', () => {
     const r = new PcmReader('SpeechStream.write');
     expect(() => r.read('UklGRg==')).toThrow(/SpeechStream\.write takes a Float32Array .* given a string \(base64 text\? decode it to bytes first\)/);
+    expect(() => r.read(new Blob([new Uint8Array(4)]))).toThrow(/given a Blob \(a WebSocket's message: set socket\.binaryType = 'arraybuffer' first\)$/);
     expect(() => r.read([0.1, 0.2])).toThrow(/given an Array$/);
     expect(() => r.read(Int32Array.of(1))).toThrow(/given an Int32Array$/);
     expect(() => r.read(Float64Array.of(0.1))).toThrow(/given a Float64Array/);
