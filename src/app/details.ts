@@ -39,12 +39,17 @@ export function takeDetails(t: Take, notes: string[]): string {
 
 /** Decode on `want` from now on (a clip being animated switches at its next chunk): say so, and keep the details' decoder line up to date. */
 export function switchBackend(engine: TalkingFaceEngine, want: Backend): void {
+  const chosen = ui.backendSelect.value;
   engine.setBackend(want).then(
     () => {
+      ui.backendSelect.dataset.chosen = chosen; // what the list goes back to if a later choice fails
       tell(`Decoding on the ${engine.backend === 'cpu' ? 'CPU' : 'WebGPU'} decoder from now on (a clip being animated switches at its next chunk).`);
       ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine));
     },
-    (err: Error) => tell(`Cannot use ${want}: ${err.message}`, true),
+    (err: Error) => {
+      ui.backendSelect.value = ui.backendSelect.dataset.chosen ?? 'auto'; // the list says what decodes: still the one before
+      tell(`Cannot use ${want}: ${err.message}`, true);
+    },
   );
 }
 

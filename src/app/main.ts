@@ -69,6 +69,7 @@ async function start(): Promise<void> {
   view = new FaceView(ui.canvas, face, { lifePaused: true }); // still until the model is ready (face-view.ts)
   player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });
   takeView = new TakeView(view);
+  player.loop = ui.loopCheck.checked; // as ticked while the face loaded, or as the browser restored the page (TakeView too)
   publish();
   ui.setupInfo.textContent = setupDetails(face, gpu);
   showStatus('Loading the model…');
@@ -117,8 +118,8 @@ function setBusy(controller: AbortController | null, isHeadRedraw = false): void
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
   const e = needEngine();
-  if (!e || recording || finishing) {
-    if (recording) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
+  if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for)
+    if (recording || recordPending) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
     else if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
@@ -234,7 +235,7 @@ async function toggleRecording(): Promise<void> {
 async function startRecording(e: TalkingFaceEngine): Promise<void> {
   stopPlayback();
   try {
-    const r = await Recording.start(e, () => microphones.open(), (f) => player.showLive(f, e.fps), (err) => tell(`Live animation stopped: ${err.message}`, true));
+    const r = await Recording.start(e, () => microphones.open(), (f) => player.showLive(f, e.fps), tell);
     stopPlayback(); // played while the microphone opened
     recording = r;
     refreshControls();
@@ -307,11 +308,11 @@ bindControls({
   togglePlay,
   seek: showFrame,
   unlockAudio: () => player?.unlock(),
-  setLoop: (on) => (player.loop = on),
-  setArrows: (on) => takeView.setArrows(on),
-  repaint: () => takeView.paint(take, engine, player.current, player.isPlaying),
-  setSideBySide: (on) => { takeView.setSideBySide(on, take); publish(); if (take) player.show(player.current); },
-  pick: (at) => takeView.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
+  setLoop: (on) => player && (player.loop = on), // (before the face is there: read once it is, in start())
+  setArrows: (on) => takeView?.setArrows(on),
+  repaint: () => takeView?.paint(take, engine, player.current, player.isPlaying),
+  setSideBySide: (on) => { if (!takeView) return; takeView.setSideBySide(on, take); publish(); if (take) player.show(player.current); },
+  pick: (at) => takeView?.pick(at) && takeView.paint(take, engine, player.current, player.isPlaying),
   setBackend: (choice) => engine && switchBackend(engine, choice === 'auto' ? autoBackend : (choice as Backend)),
   exportVideo: () => take && void exportVideoFile(view, player, take.animation.fps, take.name),
   exportGlb: () => take && engine && void exportGlbFile(take.animation, take.name, view.template, engine.unitsPerMm),

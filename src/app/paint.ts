@@ -83,6 +83,6 @@ export class Painter {
           `0<span class="ramp"></span>${max.toFixed(3)}. Click the face, or press [ or ], to choose another vertex.`);
       }
       this.painted(r.mode);
-    }, (err: Error) => this.explain(`Attention map failed: ${err.message}`));
+    }, (err: Error) => job === this.job && this.explain(`Attention map failed: ${err.message}`)); // (a later one's legend stays)
   }
 }

@@ -23,8 +23,13 @@ export class Recording {
 
   private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
 
-  /** Open the microphone (`open`) and animate it live; `onFrames` shows each chunk, `onError` reports a failure. */
-  static async start(engine: TalkingFaceEngine, open: () => Promise<MediaStream>, onFrames: (frames: Frames) => void, onError: (error: Error) => void): Promise<Recording> {
+  /**
+   * Open the microphone (`open`) and animate it live; `onFrames` shows each chunk, `tell` says what went wrong (the
+   * live animation failed, or the microphone stopped sending sound). Where listening cannot start, the microphone is
+   * let go (the browser's recording indicator goes off).
+   */
+  static async start(engine: TalkingFaceEngine, open: () => Promise<MediaStream>, onFrames: (frames: Frames) => void,
+    tell: (text: string, isError: boolean) => void): Promise<Recording> {
     const media = await open();
     engine.resetTimes();
     let recording: Recording | null = null;
@@ -32,7 +37,13 @@ export class Recording {
     const live = await engine.listen(media, (first, frames) => {
       (recording?.frames ?? pending).push({ first, frames });
       onFrames(frames);
-    }, { onError });
+    }, {
+      onError: (e) => tell(`Live animation stopped: ${e.message}`, true),
+      onInterrupted: (e) => tell(`Recording, but ${e.message}. Stop recording keeps what was heard.`, true),
+    }).catch((e: unknown) => {
+      for (const t of media.getTracks()) t.stop();
+      throw e;
+    });
     recording = new Recording(engine, live);
     recording.frames.push(...pending);
     return recording;

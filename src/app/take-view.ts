@@ -42,6 +42,8 @@ export class TakeView {
     this.painter = new Painter(view, showLegend, (mode) => (document.body.dataset.painted = mode), announce);
     this.lipMask = lipMaskOf(view.template);
     addEventListener('resize', () => this.timeline.redraw());
+    this.setArrows(ui.arrowsCheck.checked); // as ticked while the face loaded, or as the browser restored the page
+    this.setSideBySide(ui.sideCheck.checked, null, false);
   }
 
   /** Frame f of a take as drawn: on the sample subject's own face when there is ground truth. */

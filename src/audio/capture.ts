@@ -125,26 +125,34 @@ export class AudioCapture {
     if (stream.getAudioTracks().length === 0) throw new MicrophoneError('the stream has no audio track');
     if (!stream.getAudioTracks().some((t) => t.readyState === 'live')) throw new MicrophoneError('the stream\'s audio has ended (its tracks were stopped)');
     if (options.block !== undefined && !(Number.isInteger(options.block) && options.block > 0)) throw new RangeError(`block must be a whole number of samples, not ${options.block}`);
-    let context: AudioContext;
+    let context: AudioContext | undefined;
     let source: MediaStreamAudioSourceNode;
     try {
       context = new AudioContext({ sampleRate, latencyHint: 'interactive' });
       source = context.createMediaStreamSource(stream);
     } catch (atModelRate) {
-      // Some browsers cannot connect a stream to a context at another rate: run at the device's rate (and
-      // resample); if that fails too, both reasons are reported.
+      // Some browsers cannot connect a stream to a context at another rate (Firefox): run at the device's rate (and
+      // resample); if that fails too, both reasons are reported. The context that could not be used is closed.
+      void context?.close().catch(() => undefined); // (fails only when already closed: the goal)
       try {
         context = new AudioContext({ latencyHint: 'interactive' });
         source = context.createMediaStreamSource(stream);
       } catch (e) {
+        void context?.close().catch(() => undefined); // (fails only when already closed: the goal)
         throw new Error(`the microphone could not be connected to the audio system (at ${sampleRate} Hz: ${(atModelRate as Error).message}; ` +
           `at the device's rate: ${(e as Error).message})`);
       }
     }
     const rate = context.sampleRate;
     const block = Math.max(128, Math.round(((options.block ?? 256) * rate) / sampleRate));
-    await addCaptureModule(context);
-    const node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
+    let node: AudioWorkletNode;
+    try {
+      await addCaptureModule(context);
+      node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
+    } catch (e) {
+      void context.close().catch(() => undefined); // a capture that could not start holds no audio context (fails only when already closed)
+      throw e;
+    }
     const resampler = rate === sampleRate ? null : new StreamResampler(rate, sampleRate);
     const capture = { stopped: null as (() => void) | null };
     node.port.onmessage = (e: MessageEvent<Float32Array | string>) => {

@@ -277,11 +277,14 @@ export class TalkingFaceEngine {
       options.signal?.throwIfAborted();
       const F = this.frameCount(samples.length);
       const animation = await this.pipeline.restAnimation(F, options);
+      options.signal?.throwIfAborted(); // (aborted while it was made: no result, as animate's)
       options.onProgress?.(F, F);
       return { animation, speech: false };
     }
     const animation = await this.animate(samples, options);
-    return { animation, speech: await this.restUnlessSpeech(animation) };
+    const speech = await this.restUnlessSpeech(animation);
+    options.signal?.throwIfAborted(); // aborted while held at rest: no result, as animate's
+    return { animation, speech };
   }
 
   /**

@@ -34,3 +34,18 @@ test('switching to the CPU decoder during a WebGPU animation finishes the take',
   // The WebGPU decoder is destroyed once its batch under way is done, not under it.
   expect(warnings.filter((w) => /destroyed/.test(w)), 'WebGPU warnings').toEqual([]);
 });
+
+test('a decoder that cannot be used is said, and the menu goes back to the one still decoding', async ({ page }) => {
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const select = page.locator('#backend-select');
+  await select.selectOption('cpu');
+  await expect(page.locator('#status')).toContainText('Decoding on the CPU decoder from now on');
+  await page.evaluate(() => { // as where the WebGPU device cannot be had
+    const engine = (globalThis as unknown as { talkingFace: { engine: { setBackend: () => Promise<void> } } }).talkingFace.engine;
+    engine.setBackend = () => Promise.reject(new Error('the WebGPU device could not be created'));
+  });
+  await select.selectOption('webgpu');
+  await expect(page.locator('#status')).toContainText('Cannot use webgpu: the WebGPU device could not be created');
+  await expect(select).toHaveValue('cpu');
+});

@@ -13,12 +13,13 @@ type Page = import('@playwright/test').Page;
 
 /** The device each stream getUserMedia gives was opened on (window.opened), from the page's start. */
 const WATCH = () => {
-  const g = globalThis as unknown as { opened: string[] };
-  g.opened = [];
+  const g = globalThis as unknown as { opened: string[]; streams: MediaStream[] };
+  [g.opened, g.streams] = [[], []];
   const getUserMedia = navigator.mediaDevices.getUserMedia.bind(navigator.mediaDevices);
   navigator.mediaDevices.getUserMedia = async (c) => {
     const s = await getUserMedia(c);
     g.opened.push(s.getAudioTracks()[0].getSettings().deviceId ?? '?');
+    g.streams.push(s);
     return s;
   };
 };
@@ -101,6 +102,20 @@ test('a remembered microphone that is gone, asked for while the browser hides th
   await expect(page.locator('#status')).toContainText('Recording');
   await stopRecording(page);
   expect(await opened(page)).toEqual(['default']);
+});
+
+test('the demo says so when the microphone stops sending sound while recording, and Stop recording keeps what was heard', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await record(page);
+  await page.waitForTimeout(1500);
+  await page.evaluate(() => (globalThis as unknown as { streams: MediaStream[] }).streams[0].getAudioTracks()[0].stop()); // as unplugged
+  await expect(page.locator('#status')).toContainText('Recording, but the microphone stopped sending sound', { timeout: 5_000 });
+  await expect(page.locator('#status')).toHaveClass(/error/);
+  await stopRecording(page);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
 });
 
 test('the element listens to the microphone it is given, and says so plainly when that one is not connected', async ({ page }) => {
