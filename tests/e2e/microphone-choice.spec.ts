@@ -118,6 +118,23 @@ test('the demo says so when the microphone stops sending sound while recording, 
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
 });
 
+test('a file opened while the microphone is being asked for is refused, not played over the recording', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(() => { // the browser's prompt, answered after three seconds
+    const getUserMedia = navigator.mediaDevices.getUserMedia.bind(navigator.mediaDevices);
+    navigator.mediaDevices.getUserMedia = async (c) => (await new Promise((r) => setTimeout(r, 3000)), getUserMedia(c));
+  });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await page.locator('#record-button').click();
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await expect(page.locator('#status')).toContainText('Recording: stop it first');
+  await expect(page.locator('body')).toHaveAttribute('data-recording', 'true', { timeout: 20_000 });
+  await stopRecording(page);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#clip-info')).toContainText('Recording:'); // the take is the recording, not the file
+});
+
 test('the element listens to the microphone it is given, and says so plainly when that one is not connected', async ({ page }) => {
   test.setTimeout(90_000);
   await page.addInitScript(WATCH);

@@ -225,3 +225,25 @@ test('speech streamed in pieces (speakStream) drives the avatar in the page\'s o
   expect(after[1].speaking).toBe(false);
   await expect.poll(() => page.evaluate(() => (globalThis as any).ownSceneExample.state.driver.speechWeight)).toBe(0);
 });
+
+test("speakStream on the page's own context, which the page closes while it plays: done rejects saying so, the avatar rests", async ({ page }) => {
+  test.setTimeout(120_000);
+  await openExample(page);
+  const outcome = await page.evaluate(async () => {
+    const { speakStream } = await import('/lib/npm/engine.js' as string);
+    const { state } = (globalThis as any).ownSceneExample;
+    const context = new AudioContext();
+    const shown: boolean[] = [];
+    const speech = speakStream(state.engine, { sampleRate: 16000, context, show: (_f: unknown, _k: number, speaking: boolean) => shown.push(speaking) });
+    const wav = await (await fetch('/examples/sample.wav')).arrayBuffer();
+    speech.write(new Uint8Array(wav, 44, (wav.byteLength - 44) & ~1));
+    while (shown.length < 10) await new Promise((r) => setTimeout(r, 50));
+    const started = performance.now();
+    await context.close();
+    const said = await speech.done.then(() => 'resolved', (e: Error) => e.message);
+    return { said, ms: performance.now() - started, last: shown.at(-1), open: speech.open };
+  });
+  expect(outcome.said).toBe('speakStream: its audio context was closed: nothing more can play on it');
+  expect(outcome.ms, 'at once, not when the sound would have ended').toBeLessThan(1000);
+  expect([outcome.last, outcome.open]).toEqual([false, false]);
+});

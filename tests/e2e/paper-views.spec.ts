@@ -149,3 +149,22 @@ test('a clip longer than a minute exports whole as a compact .glb: 8 directions 
   await expect(page.locator('#status')).toContainText('Export cancelled.');
   expect(saved).toEqual([]);
 });
+
+test('Pose arrows and Loop ticked while the face loads are applied once it is there (no error meanwhile)', async ({ page }) => {
+  await page.addInitScript(() => document.addEventListener('DOMContentLoaded', () => {
+    for (const id of ['arrows-check', 'loop-check']) { // ticked by the visitor before the face was drawn
+      const box = document.getElementById(id) as HTMLInputElement;
+      box.checked = true;
+      box.dispatchEvent(new Event('change'));
+    }
+  }));
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const arrows = await page.evaluate(() => Boolean((globalThis as unknown as { talkingFace: { view: { arrows: unknown } } }).talkingFace.view.arrows));
+  expect(arrows, 'the pose arrows drawn').toBe(true);
+  // Looping: the short clip is still playing well after its length.
+  await page.locator('#file-input').setInputFiles({ name: 'short.wav', mimeType: 'audio/wav', buffer: (({ samples, rate }) => wav([samples.subarray(0, rate)], rate))(speechSamples()) });
+  await expect(page.locator('#play-button')).toHaveText('Pause', { timeout: 60_000 });
+  await page.waitForTimeout(2500);
+  await expect(page.locator('#play-button')).toHaveText('Pause');
+});
