@@ -19,10 +19,10 @@ test('animateSpeech aborted after its last chunk, or while a silent clip is made
     const afterLast = new AbortController(); // aborted once the last chunk is in: while the noise is held at rest
     const held = await said(engine.animateSpeech(noise, { signal: afterLast.signal, onProgress: (done: number, all: number) => done === all && afterLast.abort() }));
     const whileMade = new AbortController();
-    const silent = engine.animateSpeech(new Float32Array(16000 * 600), { signal: whileMade.signal }); // ten minutes of silence
-    setTimeout(() => whileMade.abort(), 0);
+    const silent = said(engine.animateSpeech(new Float32Array(16000 * 600), { signal: whileMade.signal })); // ten minutes of silence
+    queueMicrotask(() => whileMade.abort()); // once it has begun: while its rest frames are made
     const control = await said(engine.animateSpeech(noise)); // not aborted: it resolves
-    return { held, silent: await said(silent), control };
+    return { held, silent: await silent, control };
   });
   expect(outcome).toEqual({ held: 'AbortError', silent: 'AbortError', control: 'resolved' });
 });
