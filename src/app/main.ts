@@ -118,9 +118,9 @@ function setBusy(controller: AbortController | null, isHeadRedraw = false): void
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
   const e = needEngine();
-  if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for)
-    if (recording || recordPending) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
-    else if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
+  if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
+    if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
+    else if (recording || recordPending) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
   }
