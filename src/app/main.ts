@@ -120,7 +120,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   const e = needEngine();
   if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
     if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
-    else if (recording || recordPending) tell('Recording: stop it first (Stop recording or Escape), then open a file or a sample.');
+    else if (recording || recordPending) tell(recording ? 'Recording: stop it first (Stop recording or Escape), then open a file or a sample.' : 'The recording is starting (the browser may be asking for the microphone): stop it once it has, then open a file or a sample.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
   }

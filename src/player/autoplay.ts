@@ -19,12 +19,13 @@ export interface GestureWait {
 /**
  * Once `resumed` (the context's resume()) settles or AUTOPLAY_WAIT_MS pass, a context still suspended is resumed at
  * the next gesture, while `current()` holds. Returns what removes the listeners (call it when the sound is no longer
- * wanted: stopped, disposed); they go by themselves once the context runs or closes.
+ * wanted: stopped, disposed); they also go at the first gesture after the context runs or closes.
  */
 export function resumeOnGesture(context: AudioContext, resumed: Promise<unknown>, current: () => boolean, wait: GestureWait = {}): () => void {
   let [forgotten, listening] = [false, false];
   const resume = () => {
     void context.resume().then(() => {
+      if (forgotten) return; // (pointerdown, pointerup and touchend of one click each ask: said once)
       forget();
       if (current()) wait.onUnblocked?.();
     }, forget); // rejects only on a closed context: nothing left to play
@@ -36,9 +37,13 @@ export function resumeOnGesture(context: AudioContext, resumed: Promise<unknown>
   };
   void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
     if (forgotten || !current() || context.state !== 'suspended') return;
-    wait.onBlocked?.();
     listening = true;
     for (const g of GESTURES) document.addEventListener(g, resume, true);
+    try {
+      wait.onBlocked?.();
+    } catch (e) {
+      reportError(e); // the page's callback: its error is the page's, and the wait goes on
+    }
   });
   return forget;
 }

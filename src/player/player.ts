@@ -231,7 +231,9 @@ export class Player {
 
   /** The streamed speech `stop` is over (played out, or stopped). */
   streamDone(stop: () => void): void {
-    if (this.streaming === stop) this.streaming = null;
+    if (this.streaming !== stop) return;
+    this.streaming = null;
+    this.forgetGesture(); // over while its sound was held back: no gesture is waited for
   }
 
   /** Where sound that plays goes: the speakers at the volume, and the tap (recordVideo) as it is. */

@@ -82,4 +82,22 @@ describe('resumeOnGesture', () => {
     expect(doc.listening).toBe(0);
     expect(onUnblocked).not.toHaveBeenCalled();
   });
+
+  it("a page's onBlocked that throws is reported and the wait goes on; one click's several events unblock once", async () => {
+    const reported: unknown[] = [];
+    vi.stubGlobal('reportError', (e: unknown) => reported.push(e));
+    const context = held();
+    const onUnblocked = vi.fn();
+    resumeOnGesture(context as unknown as AudioContext, context.resume(), () => true, { onUnblocked, onBlocked: () => {
+      throw new Error('the page broke');
+    } });
+    await vi.advanceTimersByTimeAsync(2 * AUTOPLAY_WAIT_MS);
+    expect(reported).toEqual([new Error('the page broke')]);
+    expect(doc.listening).toBeGreaterThan(0);
+    context.allow();
+    for (const g of ['pointerdown', 'pointerup', 'touchend']) doc.dispatchEvent(new Event(g)); // one tap
+    await vi.advanceTimersByTimeAsync(0);
+    expect(onUnblocked).toHaveBeenCalledTimes(1);
+    expect(doc.listening).toBe(0);
+  });
 });
