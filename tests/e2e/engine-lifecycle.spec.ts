@@ -7,10 +7,16 @@ import { test, expect } from './fixtures';
  * every later call that runs the model, or gives what it computed (restFace and restArkit, also where they were
  * computed before), rejects with EngineDisposedError; calling it again does nothing.
  */
-test('animateSpeech aborted after its last chunk, or while a silent clip is made, rejects with the abort', async ({ page }) => {
-  test.setTimeout(120_000);
+test.setTimeout(120_000);
+
+/** The demo with its engine loaded (window.talkingFace.engine). */
+async function openDemo(page: import('@playwright/test').Page): Promise<void> {
   await page.goto('/');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+}
+
+test('animateSpeech aborted after its last chunk, or while a silent clip is made, rejects with the abort', async ({ page }) => {
+  await openDemo(page);
   const outcome = await page.evaluate(async () => {
     const engine = (globalThis as unknown as { talkingFace: { engine: any } }).talkingFace.engine;
     const said = (p: Promise<unknown>) => p.then(() => 'resolved', (e: Error) => e.name);
@@ -28,9 +34,7 @@ test('animateSpeech aborted after its last chunk, or while a silent clip is made
 });
 
 test('a disposed engine refuses every later call with EngineDisposedError, a rest computed before included', async ({ page }) => {
-  test.setTimeout(120_000);
-  await page.goto('/');
-  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await openDemo(page);
   const outcome = await page.evaluate(async () => {
     const engine = (globalThis as unknown as { talkingFace: { engine: any } }).talkingFace.engine;
     const before = [(await engine.restFace()).length > 0, (await engine.restArkit()).length]; // computed, and kept
