@@ -133,12 +133,12 @@ export class AudioCapture {
     } catch (atModelRate) {
       // Some browsers cannot connect a stream to a context at another rate (Firefox): run at the device's rate (and
       // resample); if that fails too, both reasons are reported. The context that could not be used is closed.
-      void context?.close().catch(() => undefined); // (fails only when already closed: the goal)
+      discard(context);
       try {
         context = new AudioContext({ latencyHint: 'interactive' });
         source = context.createMediaStreamSource(stream);
       } catch (e) {
-        void context?.close().catch(() => undefined); // (fails only when already closed: the goal)
+        discard(context);
         throw new Error(`the microphone could not be connected to the audio system (at ${sampleRate} Hz: ${(atModelRate as Error).message}; ` +
           `at the device's rate: ${(e as Error).message})`);
       }
@@ -150,7 +150,7 @@ export class AudioCapture {
       await addCaptureModule(context);
       node = new AudioWorkletNode(context, 'talking-face-capture', { numberOfInputs: 1, numberOfOutputs: 0, processorOptions: { block } });
     } catch (e) {
-      void context.close().catch(() => undefined); // a capture that could not start holds no audio context (fails only when already closed)
+      discard(context); // a capture that could not start holds no audio context
       throw e;
     }
     const resampler = rate === sampleRate ? null : new StreamResampler(rate, sampleRate);
@@ -253,6 +253,11 @@ export class AudioCapture {
 const WORKLET_FILE = 'capture-worklet.js';
 
 /** The worklet's module: a blob: URL of its text, else (a Content-Security-Policy without blob: in script-src) its file. */
+/** Close a context the capture will not use (closing fails only where it is already closed: the goal). */
+function discard(context: AudioContext | undefined): void {
+  void context?.close().catch(() => undefined); // (fails only when already closed: the goal)
+}
+
 async function addCaptureModule(context: AudioContext): Promise<void> {
   const url = URL.createObjectURL(new Blob([WORKLET], { type: 'text/javascript' }));
   try {
