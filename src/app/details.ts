@@ -37,16 +37,24 @@ export function takeDetails(t: Take, notes: string[]): string {
   return `${isolated(t.name)}: ${t.animation.frames} frames. Decoder ${t.backend}: ${speed}.` + (notes.length ? ` Notes: ${notes.join('; ')}.` : '');
 }
 
-/** Decode on `want` from now on (a clip being animated switches at its next chunk): say so, and keep the details' decoder line up to date. */
+let switches = 0;
+
+/**
+ * Decode on `want` from now on (a clip being animated switches at its next chunk): say so, and keep the details'
+ * decoder line up to date. A choice overtaken by a later one (WebGPU still being set up) says nothing.
+ */
 export function switchBackend(engine: TalkingFaceEngine, want: Backend): void {
   const chosen = ui.backendSelect.value;
+  const call = ++switches;
   engine.setBackend(want).then(
     () => {
+      if (call !== switches) return;
       ui.backendSelect.dataset.chosen = chosen; // what the list goes back to if a later choice fails
       tell(`Decoding on the ${engine.backend === 'cpu' ? 'CPU' : 'WebGPU'} decoder from now on (a clip being animated switches at its next chunk).`);
       ui.setupInfo.textContent = ui.setupInfo.textContent!.replace(/Decoder: .*$/, decoderDetails(engine));
     },
     (err: Error) => {
+      if (call !== switches) return;
       ui.backendSelect.value = ui.backendSelect.dataset.chosen ?? 'auto'; // the list says what decodes: still the one before
       tell(`Cannot use ${want}: ${err.message}`, true);
     },

@@ -27,6 +27,8 @@ export class DecoderBackends {
   reason: string;
   private pool: DecoderPool | null = null;
   private disposed = false;
+  /** Counts set()'s calls: a switch still waiting for WebGPU gives way to any later one (or to dispose). */
+  private switches = 0;
 
   private constructor(
     readonly cpu: FastDecoder,
@@ -149,10 +151,15 @@ export class DecoderBackends {
     });
   }
 
-  /** Switch decoders at run time (the numbers are the same; only speed differs). */
+  /**
+   * Switch decoders at run time (the numbers are the same; only speed differs). The latest call wins: one still
+   * waiting for WebGPU when another is made (or the engine is disposed) resolves without switching.
+   */
   async set(choice: 'auto' | Backend): Promise<void> {
+    const call = ++this.switches;
+    const overtaken = (): boolean => call !== this.switches || this.disposed;
     const backend = choice === 'auto' ? (isHardwareAdapter(await detectWebGPU()) ? 'webgpu' : 'cpu') : choice; // as at load
-    if (backend === this.backend) return;
+    if (overtaken() || backend === this.backend) return;
     if (backend === 'cpu') {
       this.gpu?.destroy();
       this.gpu = null;
@@ -161,8 +168,11 @@ export class DecoderBackends {
       return;
     }
     const support = await detectWebGPU();
+    if (overtaken()) return;
     if (!support.adapter) throw new ModelLoadError(`WebGPU is not available: ${support.description}`);
-    const decoder = new GpuDecoder(await requestSharedDevice(), this.cpu.weights, this.adjacency, this.m, this.gpuFrames);
+    const device = await requestSharedDevice();
+    if (overtaken()) return;
+    const decoder = new GpuDecoder(device, this.cpu.weights, this.adjacency, this.m, this.gpuFrames);
     this.watch(decoder);
     this.gpu = decoder;
     this.backend = 'webgpu';

@@ -244,7 +244,8 @@ export class TalkingFaceEngine {
     return this.pipeline.avatarWeights;
   }
 
-  /** Switch decoders at run time (the numbers are the same; only speed differs). */
+  /** Switch decoders at run time (the numbers are the same; only speed differs). The latest call wins
+   * (DecoderBackends.set). */
   setBackend(backend: 'auto' | Backend): Promise<void> {
     return this.pipeline.decoders.set(checkedBackend(backend));
   }

@@ -49,3 +49,21 @@ test('a decoder that cannot be used is said, and the menu goes back to the one s
   await expect(page.locator('#status')).toContainText('Cannot use webgpu: the WebGPU device could not be created');
   await expect(select).toHaveValue('cpu');
 });
+
+test('of two quick choices, the later one is what the menu and the status line say', async ({ page }) => {
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await page.evaluate(() => { // WebGPU slow to set up, and failing at last: its answer comes after the CPU's
+    const engine = (globalThis as unknown as { talkingFace: { engine: { setBackend: (b: string) => Promise<void> } } }).talkingFace.engine;
+    const real = engine.setBackend.bind(engine);
+    engine.setBackend = (b) => b === 'webgpu'
+      ? new Promise((_, reject) => setTimeout(() => reject(new Error('too slow')), 800)) : real(b);
+  });
+  const select = page.locator('#backend-select');
+  await select.selectOption('webgpu');
+  await select.selectOption('cpu');
+  await expect(page.locator('#status')).toContainText('Decoding on the CPU decoder from now on');
+  await page.waitForTimeout(1200); // past the WebGPU answer
+  await expect(page.locator('#status')).toContainText('Decoding on the CPU decoder from now on');
+  await expect(select).toHaveValue('cpu');
+});
