@@ -21,7 +21,9 @@ export class Recording {
   private readonly frames: { first: number; frames: Frames }[] = [];
   private toldSlow = false;
 
-  private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession) {}
+  private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession,
+    /** Whether a warning was told (slowNote then stays quiet: the warning is what the status line should keep). */
+    private readonly warned: () => boolean) {}
 
   /**
    * Open the microphone (`open`) and animate it live; `onFrames` shows each chunk, `tell` says what went wrong (the
@@ -34,27 +36,33 @@ export class Recording {
     engine.resetTimes();
     let recording: Recording | null = null;
     const pending: { first: number; frames: Frames }[] = [];
+    let warned = false;
+    const warn = (text: string): void => {
+      warned = true;
+      tell(text, true);
+    };
     const live = await engine.listen(media, (first, frames) => {
       (recording?.frames ?? pending).push({ first, frames });
       onFrames(frames);
     }, {
-      onError: (e) => tell(`Live animation stopped: ${e.message}`, true),
-      onInterrupted: (e) => tell(`Recording, but ${e.message}. Stop recording keeps what was heard.`, true),
+      onError: (e) => warn(`Live animation stopped: ${e.message}`),
+      onInterrupted: (e) => warn(`Recording, but ${e.message}. Stop recording keeps what was heard.`),
     }).catch((e: unknown) => {
       for (const t of media.getTracks()) t.stop();
       throw e;
     });
-    recording = new Recording(engine, live);
+    recording = new Recording(engine, live, () => warned);
     recording.frames.push(...pending);
     return recording;
   }
 
   /**
    * Once, when the device first falls behind live (frames skipped to keep up), the status line that says so; else null.
-   * A visitor sees a face that moves in jumps, and is told why, not only in the details.
+   * A visitor sees a face that moves in jumps, and is told why, not only in the details. Null after a warning (the
+   * microphone stopped sending sound, say): that stays on the status line; the skipped frames are in the details.
    */
   slowNote(): string | null {
-    if (this.toldSlow || !this.live.stream.skippedFrames) return null;
+    if (this.toldSlow || this.warned() || !this.live.stream.skippedFrames) return null;
     this.toldSlow = true;
     return 'Recording: this device is slower than real time, so the face skips frames to keep up (the take is animated whole when you stop). Stop recording or Escape stops.';
   }
