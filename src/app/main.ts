@@ -31,6 +31,7 @@ let autoBackend: Backend = 'cpu', take: Take | null = null;
 let sampleIndex: SampleIndex | null = null;
 let busy: AbortController | null = null;
 let recording: Recording | null = null, recordPending = false;
+let starting: AbortController | null = null; // Escape cancels a recording still starting (the browser asking for the microphone)
 let finishing = false; // a recording's take being finished
 let headRedraw = false; // the clip being animated is the take's head drawn again
 let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
@@ -120,7 +121,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   const e = needEngine();
   if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
     if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
-    else if (recording || recordPending) tell(recording ? 'Recording: stop it first (Stop recording or Escape), then open a file or a sample.' : 'The recording is starting (the browser may be asking for the microphone): stop it once it has, then open a file or a sample.');
+    else if (recording || recordPending) tell(recording ? 'Recording: stop it first (Stop recording or Escape), then open a file or a sample.' : 'The recording is starting (the browser may be asking for the microphone): Escape cancels it; then open a file or a sample.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
   }
@@ -234,8 +235,10 @@ async function toggleRecording(): Promise<void> {
 
 async function startRecording(e: TalkingFaceEngine): Promise<void> {
   stopPlayback();
+  const start = (starting = new AbortController());
+  showStatus('Opening the microphone (the browser may ask you first; Escape cancels)…');
   try {
-    const r = await Recording.start(e, () => microphones.open(), (f) => player.showLive(f, e.fps), tell);
+    const r = await Recording.start(e, () => microphones.open(), (f) => player.showLive(f, e.fps), tell, start.signal);
     stopPlayback(); // played while the microphone opened
     recording = r;
     refreshControls();
@@ -243,17 +246,13 @@ async function startRecording(e: TalkingFaceEngine): Promise<void> {
     ui.recordButton.classList.add('recording'); // its label says the state: no aria-pressed beside it
     document.body.dataset.recording = 'true';
     tell('Recording: the face follows your voice. Press Stop recording or Escape to stop.');
-    const update = () => {
-      if (recording !== r) return;
-      ui.takeInfo.textContent = r.describe();
-      const slow = r.slowNote();
-      if (slow) tell(slow);
-      setTimeout(update, 250);
-    };
-    update();
+    r.follow((line) => { ui.takeInfo.textContent = line; }, tell);
   } catch (err) {
+    if (start.signal.aborted) return tell('Recording cancelled before it started. Press Record to try again.');
     tell(`${(err as Error).message}`, true);
     document.body.dataset.recording = 'error';
+  } finally {
+    starting = null;
   }
 }
 
@@ -287,10 +286,11 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
   }
 }
 
-/** Escape: cancel a .glb being prepared, else stop recording, else playback, else the clip being animated. */
+/** Escape: cancel a .glb being prepared, else a recording starting, else stop recording, else playback, else the clip being animated. */
 function escape(): boolean {
   if (cancelExport()) return true;
-  if (recording) void toggleRecording();
+  if (starting) starting.abort();
+  else if (recording) void toggleRecording();
   else if (player?.isPlaying) stopPlayback();
   else if (busy) busy.abort();
   else return false;

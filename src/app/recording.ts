@@ -20,6 +20,7 @@ export interface FinishedTake {
 export class Recording {
   private readonly frames: { first: number; frames: Frames }[] = [];
   private toldSlow = false;
+  private finishing = false;
 
   private constructor(private readonly engine: TalkingFaceEngine, readonly live: LiveSession,
     /** Whether a warning was told (slowNote then stays quiet: the warning is what the status line should keep). */
@@ -28,11 +29,12 @@ export class Recording {
   /**
    * Open the microphone (`open`) and animate it live; `onFrames` shows each chunk, `tell` says what went wrong (the
    * live animation failed, or the microphone stopped sending sound). Where listening cannot start, the microphone is
-   * let go (the browser's recording indicator goes off).
+   * let go (the browser's recording indicator goes off). `signal` cancels the start, even while the browser still
+   * asks for the microphone: this rejects with its reason at once, and a microphone given after that is let go.
    */
   static async start(engine: TalkingFaceEngine, open: () => Promise<MediaStream>, onFrames: (frames: Frames) => void,
-    tell: (text: string, isError: boolean) => void): Promise<Recording> {
-    const media = await open();
+    tell: (text: string, isError: boolean) => void, signal?: AbortSignal): Promise<Recording> {
+    const media = await unlessAborted(open(), signal);
     engine.resetTimes();
     let recording: Recording | null = null;
     const pending: { first: number; frames: Frames }[] = [];
@@ -42,15 +44,20 @@ export class Recording {
       tell(text, true);
     };
     const live = await engine.listen(media, (first, frames) => {
+      if (signal?.aborted) return; // cancelled while listening started: let go below
       (recording?.frames ?? pending).push({ first, frames });
       onFrames(frames);
     }, {
       onError: (e) => warn(`Live animation stopped: ${e.message}`),
       onInterrupted: (e) => warn(`Recording, but ${e.message}. Stop recording keeps what was heard.`),
     }).catch((e: unknown) => {
-      for (const t of media.getTracks()) t.stop();
+      letGo(media);
       throw e;
     });
+    if (signal?.aborted) {
+      await live.stop(); // which lets the microphone go
+      signal.throwIfAborted();
+    }
     recording = new Recording(engine, live, () => warned);
     recording.frames.push(...pending);
     return recording;
@@ -67,6 +74,15 @@ export class Recording {
     return 'Recording: this device is slower than real time, so the face skips frames to keep up (the take is animated whole when you stop). Stop recording or Escape stops.';
   }
 
+  /** Until finish(), every quarter second: `show` describe()'s line, and `tell` the slow note when there is one. */
+  follow(show: (line: string) => void, tell: (text: string) => void): void {
+    if (this.finishing) return;
+    show(this.describe());
+    const slow = this.slowNote();
+    if (slow) tell(slow);
+    setTimeout(() => this.follow(show, tell), 250);
+  }
+
   /** One line on the live state: seconds, decoder, latency, frames skipped. */
   describe(): string {
     const lat = this.live.stream.latency;
@@ -81,6 +97,7 @@ export class Recording {
    * that: the take is then the live frames, the skipped ones held (`heldFrames`), not lost.
    */
   async finish(onReanimate: (done: number, total: number) => void, signal?: AbortSignal): Promise<FinishedTake | null> {
+    this.finishing = true;
     const e = this.engine;
     const samples = await this.live.stop();
     const rate = e.manifest.audio.sample_rate;
@@ -106,4 +123,24 @@ export class Recording {
     }
     return { animation, buffer, samples, seconds: samples.length / rate, computeMs, heldFrames };
   }
+}
+
+const letGo = (media: MediaStream): void => media.getTracks().forEach((t) => t.stop());
+
+/** The microphone `opening` gives, or `signal`'s reason as soon as it aborts (a microphone given later is let go). */
+function unlessAborted(opening: Promise<MediaStream>, signal?: AbortSignal): Promise<MediaStream> {
+  if (!signal) return opening;
+  return new Promise((resolve, reject) => {
+    const abort = (): void => reject(signal.reason);
+    if (signal.aborted) abort();
+    else signal.addEventListener('abort', abort, { once: true });
+    opening.then((media) => {
+      signal.removeEventListener('abort', abort);
+      if (signal.aborted) letGo(media);
+      else resolve(media);
+    }, (e: unknown) => {
+      signal.removeEventListener('abort', abort);
+      reject(e);
+    });
+  });
 }

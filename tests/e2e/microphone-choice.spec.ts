@@ -135,6 +135,35 @@ test('a file opened while the microphone is being asked for is refused, not play
   await expect(page.locator('#clip-info')).toContainText('Recording:'); // the take is the recording, not the file
 });
 
+test('Escape cancels a recording whose microphone prompt is unanswered; files open again, and a microphone given later is let go', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(() => { // the browser's prompt, answered when the test says (window.answer())
+    const g = globalThis as unknown as { answer: () => void; given: MediaStream[] };
+    g.given = [];
+    const getUserMedia = navigator.mediaDevices.getUserMedia.bind(navigator.mediaDevices);
+    navigator.mediaDevices.getUserMedia = async (c) => {
+      await new Promise<void>((r) => { g.answer = r; });
+      const s = await getUserMedia(c);
+      g.given.push(s);
+      return s;
+    };
+  });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  await page.locator('#record-button').click();
+  await expect(page.locator('#status')).toContainText('Opening the microphone (the browser may ask you first; Escape cancels)');
+  await page.keyboard.press('Escape');
+  await expect(page.locator('#status')).toContainText('Recording cancelled before it started');
+  await expect(page.locator('#record-button')).not.toHaveAttribute('aria-disabled', 'true');
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#clip-info')).not.toContainText('Recording');
+  await page.evaluate(() => (globalThis as unknown as { answer: () => void }).answer()); // the prompt answered at last
+  await expect.poll(() => page.evaluate(() => (globalThis as unknown as { given: MediaStream[] }).given
+    .map((s) => s.getAudioTracks()[0].readyState)), { timeout: 5_000 }).toEqual(['ended']);
+  await expect(page.locator('body')).not.toHaveAttribute('data-recording', 'true');
+});
+
 test('the element listens to the microphone it is given, and says so plainly when that one is not connected', async ({ page }) => {
   test.setTimeout(90_000);
   await page.addInitScript(WATCH);
