@@ -46,7 +46,7 @@ export function holdEngine(model: string, template: string | null, backend: stri
       held = false;
       if (--entry.holds > 0 || engines.get(key) !== entry) return;
       entry.linger = setTimeout(() => {
-        engines.delete(key);
+        if (engines.get(key) === entry) engines.delete(key); // (its load failed meanwhile: another may hold the key now)
         void entry.engine.then((e) => e.dispose(), () => undefined); // a failed load holds nothing
       }, ENGINE_LINGER_MS);
     },

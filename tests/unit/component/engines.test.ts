@@ -69,4 +69,24 @@ describe('holdEngine', () => {
     expect(load).toHaveBeenCalledTimes(2);
     later.release();
   });
+
+  it('a linger begun while a load was failing leaves the engine loaded again for that model alone', async () => {
+    vi.useFakeTimers();
+    let fail!: (e: Error) => void;
+    const again = fakeEngine();
+    vi.spyOn(TalkingFaceEngine, 'load').mockReturnValueOnce(new Promise((_, reject) => { fail = reject; })).mockResolvedValue(again);
+    const gone = holdEngine('/flaky/manifest.json', null, 'auto');
+    gone.release(); // removed while it loads: the linger starts
+    fail(new Error('offline'));
+    await expect(gone.engine).rejects.toThrow('offline');
+    const back = holdEngine('/flaky/manifest.json', null, 'auto'); // put back, within the linger: loads anew
+    expect(await back.engine).toBe(again);
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS + 1); // the first linger ends
+    const third = holdEngine('/flaky/manifest.json', null, 'auto');
+    expect(third.engine).toBe(back.engine); // still shared, not loaded a third time
+    back.release();
+    third.release();
+    await vi.advanceTimersByTimeAsync(ENGINE_LINGER_MS + 1);
+    expect(again.dispose).toHaveBeenCalledTimes(1); // and freed once the last hold goes
+  });
 });
