@@ -46,6 +46,7 @@ export class TalkingFaceElement extends ElementBase {
   private audioSeconds = 0;
   private generation = 0; // bumps on stop() and on every new speak(): stale work drops its results
   private work: AbortController | null = null; // the speak() or startMicrophone() under way: stop() aborts it
+  private opening: AbortController | null = null; // the last startMicrophone()'s work (`live` removed stops it)
   private playingStatus = '';
   private connected = false; // connectedCallback has run once
   private retrying = false; // the last load failed: the next to succeed shows the face itself
@@ -71,17 +72,11 @@ export class TalkingFaceElement extends ElementBase {
   get ready(): Promise<TalkingFaceEngine> { return this.load(); }
 
   /** The decoder's backend in use (null before the model loads); setting it sets the `backend` attribute. */
-  get backend(): Backend | null {
-    return this.engine?.backend ?? null;
-  }
-  set backend(value: 'auto' | Backend | null) {
-    reflect(this, 'backend', value);
-  }
+  get backend(): Backend | null { return this.engine?.backend ?? null; }
+  set backend(value: 'auto' | Backend | null) { reflect(this, 'backend', value); }
 
   /** The last offline animation (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it. */
-  get currentAnimation(): Animation | null {
-    return this.animation;
-  }
+  get currentAnimation(): Animation | null { return this.animation; }
 
   /** How loud the speech plays, 0 to 1 (default 1), as a media element's `volume`: the face keeps in sync at any volume. */
   get volume(): number { return this.stage.volume; }
@@ -91,13 +86,9 @@ export class TalkingFaceElement extends ElementBase {
   set muted(on: boolean) { reflect(this, 'muted', on ? '' : null); }
 
   /** The glTF avatar being driven (its three.js scene, naming scheme, head bone), or null. */
-  get avatar(): GltfAvatar | null {
-    return this.stage.view instanceof AvatarView ? this.stage.view.avatar : null;
-  }
+  get avatar(): GltfAvatar | null { return this.stage.view instanceof AvatarView ? this.stage.view.avatar : null; }
   /** Setting it sets the `avatar` attribute (its URL; null removes it), as frameworks that set properties do. */
-  set avatar(url: string | null) {
-    reflect(this, 'avatar', url);
-  }
+  set avatar(url: string | null) { reflect(this, 'avatar', url); }
 
   connectedCallback(): void {
     if (this.stage.view && this.engine) return; // moved within the page (disconnectedCallback kept everything)
@@ -132,9 +123,9 @@ export class TalkingFaceElement extends ElementBase {
       void this.load().then(() => this.afterLoad(!this.autoplayed), () => undefined); // deliberate: load() reports its failure
     } else if (name === 'src' && value) { // set while the model loads: spoken once it is in
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
-    } else if (name === 'live' && this.engine) {
+    } else if (name === 'live' && (this.engine || this.retrying)) { // (retrying: a failed load is tried again)
       if (isOn(value)) void this.startMicrophone().catch(() => undefined); // reported by fail(), as speak()
-      else this.stop();
+      else if (this.liveSession || (this.work && this.work === this.opening)) this.stop(); // a speak() begun since goes on
     }
   }
 
@@ -151,13 +142,13 @@ export class TalkingFaceElement extends ElementBase {
       take = await makeTake(engine, audio, this, signal, (text, announce) => gen === this.generation && this.status.set(text, false, announce));
     } catch (e) {
       if (gen !== this.generation) return; // stopped: the abort is no failure
-      throw e instanceof TakeError ? this.fail(e.stage, e.message) : e;
+      throw e instanceof TakeError ? this.fail(e.stage, e.message, gen) : e;
     }
-    this.work = null; // animated: stop() from here stops the playback
     [this.computeMs, this.audioSeconds] = [take.computeMs, take.seconds];
     const player = await this.stage.settled(); // an avatar may still be loading
     if (gen !== this.generation) return;
-    if (!player) throw this.fail('avatar', this.stage.error ?? 'there is no face to show it on (is the element in the page?)');
+    if (!player) throw this.fail('avatar', this.stage.error ?? 'there is no face to show it on (is the element in the page?)', gen);
+    this.work = null; // animated: stop() from here stops the playback
     this.animation = take.animation;
     player.load(take.animation, take.decoded.buffer);
     player.show(0);
@@ -192,7 +183,7 @@ export class TalkingFaceElement extends ElementBase {
   /** What work of generation `gen` (stopped by `signal`) is lent: the model, the player, the status line, the events. */
   private host(gen: number, signal: AbortSignal): WorkHost {
     return { signal, element: this, engine: unlessAborted(this.load(), signal), player: () => this.stage.player, settled: () => this.stage.settled(),
-      current: () => gen === this.generation, status: (text) => this.status.set(text), fail: (stage, message) => this.fail(stage, message),
+      current: () => gen === this.generation, status: (text) => this.status.set(text), fail: (stage, message) => this.fail(stage, message, gen),
       playing: (text) => this.status.set((this.playingStatus = text)), dispatch: (event) => this.dispatchEvent(event), halt: () => this.halt(false) };
   }
 
@@ -209,6 +200,7 @@ export class TalkingFaceElement extends ElementBase {
    */
   async startMicrophone(options: { deviceId?: string } = {}): Promise<void> {
     const { gen, signal } = this.begin();
+    this.opening = this.work;
     const live = await listenLive(this.host(gen, signal), (stage, message) => (this.fail(stage, message), this.halt(false)), options?.deviceId);
     if (live && gen !== this.generation) void live.stop(); // stopped as it started: the microphone released
     else if (live) [this.liveSession, this.work] = [live, null];
@@ -220,7 +212,7 @@ export class TalkingFaceElement extends ElementBase {
     if (this.speech?.open) throw this.fail('render', 'streamed speech is playing: record once it has played (its take is then recorded)');
     if (!engine || !animation) throw this.fail('render', 'there is no take to record: speak() one first');
     return this.stage.recordVideo(engine.fps, options.signal ?? new AbortController().signal, (f) => options.onProgress?.(f / engine.fps))
-      .catch((e: Error) => Promise.reject(options.signal?.aborted ? e : this.fail('render', `the video could not be made: ${e.message}`)));
+      .catch((e: Error) => Promise.reject(options.signal?.aborted ? (this.rest(), e) : this.fail('render', `the video could not be made: ${e.message}`)));
   }
 
   /** Stop playback and the microphone; the face (or avatar) goes back to rest. */
@@ -236,16 +228,19 @@ export class TalkingFaceElement extends ElementBase {
     this.work = null;
     cancelled?.abort(); // an animation under way stops at its next chunk
     this.stage.player?.stop();
-    if (wasPlaying || this.liveSession) {
-      (this.stage.view as PlayerView | null)?.setSpeaking?.(false); // back to the face at rest
-      this.dispatchEvent(new CustomEvent('ended')); // speak() resolves on stop() too
-    }
+    if (wasPlaying || this.liveSession) this.rest(); // (speak() resolves on stop() too)
     if (this.liveSession) {
       const live = this.liveSession;
       this.liveSession = null;
       if (say) this.status.set('Stopped listening.'); // the microphone is released at once; the take's end follows
       void live.stop();
     } else if (say && (wasPlaying || cancelled)) this.status.set('Stopped.');
+  }
+
+  /** Back to the face at rest, and `ended`: what a take stopped before its end does. */
+  private rest(): void {
+    (this.stage.view as PlayerView | null)?.setSpeaking?.(false);
+    this.dispatchEvent(new CustomEvent('ended'));
   }
 
   private load(): Promise<TalkingFaceEngine> {
@@ -265,7 +260,7 @@ export class TalkingFaceElement extends ElementBase {
         (e: Error) => {
           if (this.hold !== hold) throw e; // superseded (another model or backend): its failure is no longer the element's
           [this.loading, this.hold, this.retrying] = [null, null, true]; // a later call retries
-          throw this.fail('model', `the model could not be loaded: ${e.message}`);
+          throw this.fail('model', `the model could not be loaded: ${e.message}`, this.generation); // (the work waiting on it fails)
         },
       );
     }
@@ -320,8 +315,8 @@ export class TalkingFaceElement extends ElementBase {
   }
 
   /** Show and dispatch an error; returns it so callers can throw it. */
-  private fail(stage: TalkingFaceErrorDetail['stage'], message: string): Error {
-    this.work = null; // failed: nothing left for stop() to cancel
+  private fail(stage: TalkingFaceErrorDetail['stage'], message: string, gen?: number): Error {
+    if (gen === this.generation) this.work = null; // that work failed: nothing left for stop() to cancel
     this.status.set(message, true);
     this.dispatchEvent(new CustomEvent<TalkingFaceErrorDetail>('error', { detail: { message, stage } }));
     return new TalkingFaceError(stage, message);

@@ -96,6 +96,46 @@ test('stop() cancels an animation under way: speak() resolves, the status says s
   expect((await page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents)).left).not.toContain('frame:playback');
 });
 
+test('a call that fails beside a speak() under way leaves stop() able to cancel it; removing `live` stops the microphone, not a speak() begun since', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.addInitScript(WATCH);
+  await page.goto('/examples/embed.html');
+  await expect.poll(() => page.evaluate(statusOf('left')), { timeout: 60_000 }).toContain('Ready');
+  const timing = await page.evaluate(async () => {
+    const rate = 16000, seconds = 120; // seconds of work on two cores (as above)
+    const buffer = new AudioBuffer({ length: rate * seconds, sampleRate: rate, numberOfChannels: 1 });
+    const x = buffer.getChannelData(0);
+    for (let i = 0; i < x.length; i++) x[i] = 0.2 * Math.sin(2 * Math.PI * 3 * i / rate) * Math.sin(2 * Math.PI * 140 * i / rate);
+    const left = document.getElementById('left') as unknown as { speak(a: AudioBuffer): Promise<void>; stop(): void; recordVideo(): Promise<Blob> };
+    const status = () => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent!;
+    const spoken = left.speak(buffer);
+    while (!status().startsWith('Animating')) await new Promise((r) => setTimeout(r, 50));
+    const refused = await left.recordVideo().then(() => 'made', (e: Error) => e.message); // no take yet: it fails, and says so
+    const stoppedAt = performance.now();
+    left.stop();
+    await spoken;
+    return { refused, resolvedAfterMs: performance.now() - stoppedAt, status: status() };
+  });
+  expect(timing.refused).toContain('there is no take to record');
+  expect(timing.resolvedAfterMs, 'speak() resolves soon after stop()').toBeLessThan(3000);
+  expect(timing.status).toBe('Stopped.');
+
+  // Listening; then, as a framework does for a button that says "speak this instead": speak(), then `live` removed.
+  await page.locator('#right').evaluate((el) => el.setAttribute('live', ''));
+  await expect.poll(() => page.evaluate(() => (globalThis as unknown as { faceEvents: Record<string, string[]> }).faceEvents.right?.filter((e) => e === 'frame:live').length ?? 0), { timeout: 30_000 }).toBeGreaterThan(3);
+  const spoke = await page.locator('#right').evaluate(async (el) => {
+    const face = el as unknown as { speak(a: string): Promise<void> };
+    const spoken = face.speak('/examples/sample.wav');
+    el.removeAttribute('live');
+    let frames = 0;
+    el.addEventListener('frame', (e) => { if ((e as CustomEvent).detail.mode === 'playback') frames++; });
+    await spoken;
+    return frames;
+  });
+  expect(spoke, 'the speak() played').toBeGreaterThan(10);
+  expect(await page.evaluate(statusOf('right'))).toMatch(/^Played/);
+});
+
 test('one element\'s backend attribute leaves the others\' engines alone; a bad value warns and means auto', async ({ page }) => {
   test.setTimeout(180_000);
   await page.addInitScript(WATCH);

@@ -34,11 +34,13 @@ test('the element records its last take as a video with its sound; before a take
     const canvas = el.shadowRoot!.querySelector('canvas')!;
     // Cancelled a moment in: rejected with the signal's reason, no error event.
     const stop = new AbortController();
+    let ended = 0; // the cancelled recording's take stops: the face rests, and `ended` says so
+    f.addEventListener('ended', () => ended++);
     const cancelled = f.recordVideo({ signal: stop.signal }).then(() => 'made', (e: Error) => e.name);
     setTimeout(() => stop.abort(), 500);
     const take = f.currentAnimation!;
     return { type: blob.type, magic: [...data.subarray(0, 4)], seconds: sound.duration, take: take.frames / take.fps, peak, progress,
-      size: [video.videoWidth, video.videoHeight], canvas: [canvas.width, canvas.height], cancelled: await cancelled, errors };
+      size: [video.videoWidth, video.videoHeight], canvas: [canvas.width, canvas.height], cancelled: await cancelled, endedOnCancel: ended, errors };
   });
   console.log(`element video: ${JSON.stringify(read)}`);
   expect(read.type).toMatch(/^video\/(webm|mp4)$/);
@@ -49,5 +51,6 @@ test('the element records its last take as a video with its sound; before a take
   expect(read.progress).toBeGreaterThan(0.5 * read.take);
   expect(read.size).toEqual(read.canvas);
   expect(read.cancelled).toBe('AbortError');
+  expect(read.endedOnCancel).toBe(1);
   expect(read.errors).toEqual([]);
 });
