@@ -131,3 +131,27 @@ test('live frame events count the frames skipped to stay live, and a device that
   // a run in the whole suite saw 43, 43, 59, 118 around it: the hold's frames skipped at the third).
   expect(Math.max(...s.slice(before, before + 3)) - s[before - 1], `frames skipped over the held 1.5 s: ${s}`).toBeGreaterThanOrEqual(20);
 });
+
+test('live set again after the model failed to load loads it again and listens', async ({ page, guard }) => {
+  test.setTimeout(120_000);
+  guard.allowConsoleError(/ERR_INTERNET_DISCONNECTED/);
+  let asked = 0; // the first request for the model fails, as offline; the next one is served
+  await page.route('**/models/manifest.json?flaky', (route) => (asked++ === 0 ? route.abort('internetdisconnected') : route.continue()));
+  const failed = await page.evaluate(() => new Promise<string>((resolve) => {
+    const el = document.createElement('talking-face');
+    Object.assign(el, { id: 'flaky' });
+    el.setAttribute('model', '/models/manifest.json?flaky');
+    el.setAttribute('live', '');
+    el.addEventListener('error', (e) => resolve((e as CustomEvent).detail.stage), { once: true });
+    document.body.append(el);
+  }));
+  expect(failed).toBe('model');
+  await page.evaluate(() => {
+    const el = document.getElementById('flaky')!;
+    el.removeAttribute('live');
+    el.setAttribute('live', '');
+  });
+  await expect.poll(() => page.evaluate(() => document.getElementById('flaky')!.shadowRoot!.querySelector('p.status')!.textContent!), { timeout: 60_000 }).toContain('Listening');
+  expect(asked).toBe(2);
+  await page.evaluate(() => (document.getElementById('flaky') as unknown as { stop(): void }).stop());
+});
