@@ -7,12 +7,12 @@
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
-import { fitToCanvas, OnScreen } from '../render/canvas-size';
+import { fitToCanvas, CanvasWatch } from '../render/canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { BlendshapeFrames } from './weights';
 import { GltfAvatar, type AvatarBindOptions } from './gltf-avatar';
 import { AvatarDriver } from './avatar-driver';
-import { NO_WEBGL, pixelRatio, softwareWebGL, webglAvailable } from '../render/software-gl';
+import { NO_WEBGL, softwareWebGL, webglAvailable } from '../render/software-gl';
 import { fetchBody, StalledError } from '../model/fetch-body';
 
 /** About a head's bounding radius in metres (glTF's unit). */
@@ -23,8 +23,7 @@ export class AvatarView {
   readonly scene = new THREE.Scene();
   readonly camera: THREE.PerspectiveCamera;
   readonly controls: OrbitControls;
-  private readonly resizeObserver: ResizeObserver;
-  private readonly onScreen: OnScreen;
+  private readonly watch: CanvasWatch; // its size, the screen's pixel ratio, whether it is on screen, a context restored
   recording = false; // draw even while out of sight (a recording of the canvas needs its frames: player/record-video.ts)
   private needsRender = true;
   private frameHandle = 0;
@@ -37,7 +36,6 @@ export class AvatarView {
     this.driver = new AvatarDriver(avatar, performance.now());
     if (!webglAvailable()) throw new Error(NO_WEBGL); // plainly, not three.js's "Error creating WebGL context"
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: !softwareWebGL(), alpha: false }); // render/software-gl.ts
-    this.renderer.setPixelRatio(pixelRatio());
     this.scene.background = new THREE.Color(0x1d2230);
     this.scene.add(avatar.gltf.scene);
     if (avatar.facing === '-z') avatar.gltf.scene.rotation.y += Math.PI; // its face towards the camera (it turns in its own axes)
@@ -69,9 +67,7 @@ export class AvatarView {
     this.controls.addEventListener('change', () => this.requestRender());
     this.controls.update();
 
-    this.resizeObserver = new ResizeObserver(() => this.resize());
-    this.resizeObserver.observe(canvas);
-    this.onScreen = new OnScreen(canvas, () => this.requestRender());
+    this.watch = new CanvasWatch(canvas, () => this.resize(), () => this.requestRender());
     this.resize();
     this.loop();
   }
@@ -131,8 +127,7 @@ export class AvatarView {
 
   dispose(): void {
     cancelAnimationFrame(this.frameHandle);
-    this.resizeObserver.disconnect();
-    this.onScreen.disconnect();
+    this.watch.disconnect();
     this.controls.dispose();
     this.scene.traverse((o) => {
       const mesh = o as THREE.Mesh;
@@ -146,7 +141,7 @@ export class AvatarView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
-    if (!this.onScreen.shown && !this.recording) return;
+    if (!this.watch.shown && !this.recording) return;
     if (this.controls.update()) this.needsRender = true;
     this.driver.blinking = !this.reducedMotion?.matches;
     if (this.driver.update(performance.now())) this.needsRender = true;

@@ -12,7 +12,7 @@
  * The caller owns the canvas. Nothing is allocated per frame.
  */
 import * as THREE from 'three';
-import { fitToCanvas, OnScreen } from './canvas-size';
+import { fitToCanvas, CanvasWatch } from './canvas-size';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { FaceTemplate } from '../template/face-template';
 import { Head } from './head';
@@ -21,7 +21,7 @@ import { IdleMotion, type IdleState } from './idle-motion';
 import { heat, lightScene } from './materials';
 import { shareTongueProgram } from './mouth-interior';
 import { pickFaceVertex, poseArrows } from './overlays';
-import { NO_WEBGL, pixelRatio, softwareWebGL, webglAvailable } from './software-gl';
+import { NO_WEBGL, softwareWebGL, webglAvailable } from './software-gl';
 
 export interface FaceViewOptions {
   /** Breathing, blinks and eye movements (default true). Off for a view that must show exactly what it is given. */
@@ -69,8 +69,7 @@ export class FaceView {
   private tongue = 0;
   recording = false; // draw even while out of sight (a recording of the canvas needs its frames: player/record-video.ts)
   private readonly pose = new Float32Array(6);
-  private readonly resizeObserver: ResizeObserver;
-  private readonly onScreen: OnScreen;
+  private readonly watch: CanvasWatch; // its size, the screen's pixel ratio, whether it is on screen, a context restored
   private needsRender = true;
   private frameHandle = 0;
   private lastTime = -1;
@@ -87,7 +86,6 @@ export class FaceView {
   ) {
     if (!webglAvailable()) throw new Error(NO_WEBGL); // plainly, not three.js's "Error creating WebGL context"
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: options.antialias ?? !softwareWebGL(), alpha: false });
-    this.renderer.setPixelRatio(pixelRatio());
     this.model = new Head(template);
     shareTongueProgram(this.model);
     this.head = this.model.group;
@@ -120,9 +118,7 @@ export class FaceView {
     this.controls.addEventListener('change', () => this.requestRender());
     this.controls.update();
 
-    this.resizeObserver = new ResizeObserver(() => this.resize());
-    this.resizeObserver.observe(canvas);
-    this.onScreen = new OnScreen(canvas, () => this.requestRender());
+    this.watch = new CanvasWatch(canvas, () => this.resize(), () => this.requestRender());
     this.resize();
     this.compose();
     // The first frame is drawn at the next animation frame, not here: what the caller starts meanwhile (the model's
@@ -265,8 +261,7 @@ export class FaceView {
 
   dispose(): void {
     cancelAnimationFrame(this.frameHandle);
-    this.resizeObserver.disconnect();
-    this.onScreen.disconnect();
+    this.watch.disconnect();
     this.controls.dispose();
     this.model.dispose();
     this.environment.dispose();
@@ -303,7 +298,7 @@ export class FaceView {
 
   private loop = (): void => {
     this.frameHandle = requestAnimationFrame(this.loop);
-    if (!this.onScreen.shown && !this.recording) return; // (its life and camera catch up when it is shown again)
+    if (!this.watch.shown && !this.recording) return; // (its life and camera catch up when it is shown again)
     // Damping keeps moving the camera for a few frames after the pointer stops.
     if (this.controls.update()) this.needsRender = true;
     if ((this.idle && this.alive) || this.idleState || this.speech !== this.speechTarget) this.update(performance.now() / 1000);

@@ -36,14 +36,27 @@ for (const [fault, pattern] of [['the runtime (.wasm) is not found', '**/ort/*/o
   });
 }
 
-test('a face whose WebGL context the browser takes says so, and again when it is given back', async ({ page, guard }) => {
+test('a face whose WebGL context the browser takes says so, and again when it is given back, drawn again even at rest', async ({ page, guard }) => {
   test.setTimeout(60_000);
   guard.allowConsoleError(/WebGL|CONTEXT_LOST/);
+  // An avatar held still at rest (no blinks): nothing but the restore asks for a frame. Its draw calls are counted
+  // (a restored context's drawing buffer is blank until drawn; this headless browser may still show the old one).
+  await page.emulateMedia({ reducedMotion: 'reduce' });
+  await page.addInitScript(() => {
+    const g = globalThis as unknown as { draws: number };
+    g.draws = 0;
+    const draw = WebGL2RenderingContext.prototype.drawElements;
+    WebGL2RenderingContext.prototype.drawElements = function (...args: Parameters<typeof draw>) { g.draws++; return draw.apply(this, args); };
+    document.addEventListener('DOMContentLoaded', () => document.getElementById('left')!.setAttribute('avatar', '/examples/avatars/arkit-face.glb'));
+  });
   await page.goto('/examples/embed.html');
   await page.evaluate(() => (document.getElementById('left') as El).ready);
   const status = () => page.evaluate(() => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent);
   await expect.poll(status, { timeout: 30_000 }).toContain('Ready');
   const errors = page.evaluate(() => new Promise<string>((resolve) => document.getElementById('left')!.addEventListener('error', (e) => resolve((e as unknown as CustomEvent).detail.stage), { once: true })));
+  const draws = () => page.evaluate(() => (globalThis as unknown as { draws: number }).draws);
+  await page.waitForTimeout(1000);
+  const atRest = await draws();
   await page.evaluate(() => {
     const gl = document.getElementById('left')!.shadowRoot!.querySelector('canvas')!.getContext('webgl2')!;
     const ext = gl.getExtension('WEBGL_lose_context')!;
@@ -51,7 +64,9 @@ test('a face whose WebGL context the browser takes says so, and again when it is
     setTimeout(() => ext.restoreContext(), 500);
   });
   expect(await errors).toBe('render');
+  expect(await draws(), 'nothing drawn at rest before the loss').toBe(atRest);
   await expect.poll(status, { timeout: 10_000 }).toBe('The face is drawn again.');
+  await expect.poll(draws, { timeout: 2_000, message: 'the avatar is drawn again once the context is back' }).toBeGreaterThan(atRest);
 });
 
 test('the demo\'s face whose WebGL context the browser takes says so, and again when it is given back', async ({ page, guard }) => {
