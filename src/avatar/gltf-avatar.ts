@@ -93,10 +93,15 @@ export class GltfAvatar {
     if (declared > bytes.byteLength) {
       throw new AvatarLoadError(`${source} is cut short: its header says ${declared} bytes, ${bytes.byteLength} came (an interrupted download or upload?)`);
     }
+    const used = extensionsOf(bytes, magic === 'glTF');
+    const refused = undecoded(used, source);
+    if (refused) throw new AvatarLoadError(refused);
     const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+    const loader = new GLTFLoader();
+    if (used.used.some((e) => MESHOPT.includes(e))) loader.setMeshoptDecoder((await import('three/addons/libs/meshopt_decoder.module.js')).MeshoptDecoder);
     let gltf: GLTF;
     try {
-      gltf = await new GLTFLoader().parseAsync(bytes, folderOf(source));
+      gltf = await loader.parseAsync(bytes, folderOf(source));
     } catch (e) {
       throw new AvatarLoadError(`${source} could not be read as glTF: ${(e as Error).message}`);
     }
@@ -234,3 +239,36 @@ const ZEROS = new Float32Array(ARKIT_NAMES.length);
 const scratch = new THREE.Quaternion();
 const inverse = new THREE.Quaternion();
 const axis = new THREE.Vector3();
+
+/** Meshopt compression (gltfpack, gltf-transform optimize): decoded (its decoder is WebAssembly inside the script). */
+const MESHOPT = ['EXT_meshopt_compression', 'KHR_meshopt_compression'];
+
+/** The extensions a glTF's JSON says it uses and requires (none where it cannot be read: GLTFLoader then says why). */
+function extensionsOf(bytes: ArrayBuffer, binary: boolean): { used: string[]; required: string[] } {
+  try {
+    const view = new DataView(bytes);
+    const text = binary ? new Uint8Array(bytes, 20, view.getUint32(12, true)) : new Uint8Array(bytes);
+    const json = JSON.parse(new TextDecoder().decode(text)) as { extensionsUsed?: unknown; extensionsRequired?: unknown };
+    const names = (list: unknown): string[] => (Array.isArray(list) ? list.filter((e): e is string => typeof e === 'string') : []);
+    return { used: names(json.extensionsUsed), required: names(json.extensionsRequired) };
+  } catch {
+    return { used: [], required: [] }; // not readable here: GLTFLoader's own message says what is wrong
+  }
+}
+
+/**
+ * Why a glTF cannot be read here, or null: Draco meshes (GLTFLoader cannot read them at all without a DRACOLoader,
+ * whose decoder would be fetched from elsewhere) and KTX2 textures it requires (the same, a KTX2Loader's transcoder).
+ */
+function undecoded(e: { used: string[]; required: string[] }, source: string): string | null {
+  const own = 'or load it in your own three.js scene with that loader and drive it with GltfAvatar.bind and AvatarDriver (docs/embedding.md)';
+  if (e.used.includes('KHR_draco_mesh_compression')) {
+    return `${source} is compressed with Draco (KHR_draco_mesh_compression), which this library does not decode: export it ` +
+      `without mesh compression (Ready Player Me: without meshCompression=true; meshopt compression is decoded), ${own.replace('that loader', 'a DRACOLoader')}`;
+  }
+  if (e.required.includes('KHR_texture_basisu')) {
+    return `${source} has KTX2 (Basis Universal) textures only (KHR_texture_basisu), which this library does not decode: export ` +
+      `it with PNG, JPEG or WebP textures, ${own.replace('that loader', 'a KTX2Loader')}`;
+  }
+  return null;
+}

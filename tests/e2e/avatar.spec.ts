@@ -8,6 +8,7 @@ import { VRMAnimationLoaderPlugin, type VRMAnimation } from '@pixiv/three-vrm-an
 import { GltfAvatar } from '../../src/avatar/gltf-avatar';
 import { editGlbJson } from '../../src/avatar/gltf-nodes';
 import { ARKIT_NAMES, LIVE_LINK_FACE_COLUMNS } from '../../src/avatar/names';
+import { meshopt, readGlb, writeGlb } from '../unit/helpers/glb';
 
 /**
  * <talking-face avatar="..."> with the project's own test avatars (examples/avatars/, npm run make-avatars) on
@@ -210,6 +211,13 @@ test('an avatar file that is not glTF, or has neither naming scheme, gives a cle
   const prefixed = await errorOf(await blobUrl(renamedAvatar((n) => (n === 'viseme_aa' ? 'Viseme_AA' : `blendShape1.${n}`))));
   expect(prefixed).toMatch(/^ready: .*"scheme":"visemes"/);
   expect(JSON.parse(prefixed.slice('ready: '.length)).matched).toHaveLength(15);
+  // Compressed: meshopt is decoded (the library's decoder chunk, loaded when a file needs it); Draco is refused plainly.
+  const packed = await errorOf(await blobUrl(Buffer.from(await meshopt(resolve(AVATARS, 'arkit-face.glb'))).toString('base64')));
+  expect(packed).toMatch(/^ready: /);
+  expect(JSON.parse(packed.slice('ready: '.length))).toEqual({ scheme: 'arkit', matched: [...ARKIT_NAMES], headBone: 'Head' });
+  const { json, bin } = readGlb(resolve(AVATARS, 'arkit-face.glb'));
+  const draco = writeGlb({ ...json, extensionsUsed: ['KHR_draco_mesh_compression'], extensionsRequired: ['KHR_draco_mesh_compression'] }, bin);
+  expect(await errorOf(await blobUrl(Buffer.from(draco).toString('base64')))).toMatch(/^avatar: the avatar cannot be used: blob:.* is compressed with Draco \(KHR_draco_mesh_compression\), which this library does not decode/);
 });
 
 test('avatar-facing="-z" shows an avatar made facing -z (VRM 0.x) as a +z one', async ({ page }) => {
