@@ -43,7 +43,8 @@ export interface FaceBinding {
   vrmVersion: string | null;
 }
 
-const isMouth = (channel: number) => /^(jaw|mouth)/.test(ARKIT_NAMES[channel]);
+/** ARKit's shapes that open the mouth: the jaw, and the lips parted (a smile or a press beside visemes opens nothing). */
+const OPENS_MOUTH = new Set((['jawOpen', 'mouthLowerDownLeft', 'mouthLowerDownRight', 'mouthUpperUpLeft', 'mouthUpperUpRight'] as const).map((n) => ARKIT_INDEX[n]));
 const isBlink = (channel: number) => channel === ARKIT_INDEX.eyeBlinkLeft || channel === ARKIT_INDEX.eyeBlinkRight;
 const VRM_BLINKS = ['blinkLeft', 'blinkRight', 'blink'];
 
@@ -106,8 +107,9 @@ function expressionsOf(threeVrm: ThreeVrmLike | null, file: VrmFile | null): Exp
 }
 
 /**
- * Which output drives the face, or null for nothing to drive. ARKit when it has an ARKit mouth or jaw shape, else the
- * visemes when it has viseme targets, else a VRM's vowels; an avatar with only ARKit eye shapes is ARKit's too. For a
+ * Which output drives the face, or null for nothing to drive. ARKit when it has an ARKit shape that opens the mouth
+ * (jawOpen, or the lips parted: OPENS_MOUTH), else the visemes when it has viseme targets, else a VRM's vowels; an
+ * avatar with only other ARKit shapes (eyes, a smile) and no visemes is ARKit's too. For a
  * VRM, only a scheme that opens the mouth: ARKit where jawOpen is reached (a target no expression binds, or an
  * expression named so), the visemes where viseme_aa is; else its vowels, whatever else it has (a VRM whose vowels
  * bind its viseme or ARKit targets leaves the others alone, and they cannot open its mouth).
@@ -116,7 +118,7 @@ function schemeOf(arkit: Target[], arkitExpressions: [string, number][], visemes
   const anyVowel = vowels.some(Boolean);
   const arkitMouth = isVrm
     ? arkit.some((t) => t.channel === ARKIT_INDEX.jawOpen) || arkitExpressions.some(([, c]) => c === ARKIT_INDEX.jawOpen)
-    : arkit.some((t) => isMouth(t.channel));
+    : arkit.some((t) => OPENS_MOUTH.has(t.channel));
   const visemeMouth = isVrm ? visemes.some((t) => VISEME_NAMES[t.channel] === 'viseme_aa') : visemes.length > 0;
   if (arkitMouth) return 'arkit';
   if (visemeMouth) return 'visemes';

@@ -91,8 +91,15 @@ describe('GltfAvatar', () => {
     a.setWeights(w, 0, v, 0);
     expect(influences(a)('viseme_PP')).toBeCloseTo(0.8, 6);
     expect(influences(a)('eyeBlinkRight')).toBeCloseTo(0.7, 6);
-    // One ARKit mouth shape beside them is an ARKit rig (ARKit wins when it has the mouth).
+    // One ARKit shape that opens the mouth beside them is an ARKit rig (ARKit wins when it has the mouth)...
     expect(GltfAvatar.bind(fake([...names, 'jawOpen']), 'x.glb').summary.scheme).toBe('arkit');
+    expect(GltfAvatar.bind(fake([...names, 'mouthLowerDown_L', 'mouthLowerDown_R']), 'x.glb').summary.scheme).toBe('arkit');
+    // ...and ARKit smiles or presses, which open nothing, leave the visemes driving the mouth (as Character Creator exports).
+    const smiling = GltfAvatar.bind(fake([...names, 'mouthSmile_L', 'mouthSmile_R', 'mouthPressLeft']), 'x.glb');
+    expect(smiling.summary.scheme).toBe('visemes');
+    expect(smiling.summary.matched).toEqual([...VISEME_NAMES]);
+    // Without visemes, ARKit shapes that do not open the mouth are still what there is to drive.
+    expect(GltfAvatar.bind(fake(['mouthSmile_L', 'eyeBlinkLeft']), 'x.glb').summary.scheme).toBe('arkit');
   });
 
   it("takes the file's bytes as an ArrayBuffer, a Uint8Array or Node's Buffer, and says what else it was given", async () => {
