@@ -4,7 +4,8 @@
  *
  *   const driver = new AvatarDriver(GltfAvatar.bind(gltf, 'me.glb'));
  *   driver.setRest(await engine.restArkit());
- *   driver.show(take, Math.floor(audio.currentTime * take.fps));   // each frame of the page's loop
+ *   const f = Math.floor(audio.currentTime * take.fps);            // each frame of the page's loop:
+ *   if (f >= 0 && f < take.frames) driver.show(take, f);           // (at the audio's very end f can be take.frames)
  *   driver.update(performance.now());                              // blends and blinks; then the page renders
  *
  * Per frame it sets the avatar's morph targets (ARKit weights, or visemes) and turns its head bone by the predicted

@@ -15,8 +15,9 @@ export { AvatarLoadError, type AvatarScheme };
 
 export interface AvatarSummary {
   /**
-   * Which output drives the face: ARKit weights when the avatar has an ARKit target that opens the mouth (jawOpen, mouthLowerDown…, mouthUpperUp…), else the visemes
-   * when it has viseme targets (with eyeBlinkLeft / eyeBlinkRight, if it has them, still driven as blinks), else,
+   * Which output drives the face: ARKit weights when the avatar has an ARKit target that opens the mouth (jawOpen,
+   * mouthLowerDown…, mouthUpperUp…), else the visemes when it has viseme targets (with eyeBlinkLeft / eyeBlinkRight,
+   * if it has them, still driven as blinks), else,
    * for a VRM, its vowel expressions (aa ih ou ee oh, made from the visemes: vrm.ts) and its blink expressions. A
    * VRM is ARKit's only where its jawOpen is reached, the visemes' only where its viseme_aa is (face-binding.ts).
    */
