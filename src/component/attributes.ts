@@ -65,8 +65,11 @@ function readable(url: string): string {
   }
 }
 
-/** speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is another origin's). */
-export async function audioInput(audio: Blob | AudioBuffer | URL | string): Promise<Blob | AudioBuffer> {
+/**
+ * speak()'s audio as something decodeAudio takes: a URL is fetched (the message names it, with its host when it is
+ * another origin's); `signal` cancels the download.
+ */
+export async function audioInput(audio: Blob | AudioBuffer | URL | string, signal?: AbortSignal): Promise<Blob | AudioBuffer> {
   if (audio instanceof Blob || (typeof AudioBuffer !== 'undefined' && audio instanceof AudioBuffer)) return audio;
   if (!(typeof audio === 'string' || audio instanceof URL) || audio === '') {
     const got = audio === null ? 'null' : audio === '' ? 'an empty string' : typeof audio === 'object' ? (audio as object).constructor?.name ?? 'an object' : typeof audio;
@@ -74,7 +77,8 @@ export async function audioInput(audio: Blob | AudioBuffer | URL | string): Prom
   }
   const url = new URL(String(audio), document.baseURI);
   const shown = readable(url.origin === location.origin ? url.pathname : url.href);
-  const res = await fetchBody(url).catch((e: Error) => {
+  const res = await fetchBody(url, { signal }).catch((e: Error) => {
+    if (signal?.aborted) throw e;
     throw new Error(`could not fetch ${shown}: ${e.message}`);
   });
   if (!res.ok) throw new Error(`could not fetch ${shown}: HTTP ${res.status}`);

@@ -30,7 +30,7 @@ export async function makeTake(engine: TalkingFaceEngine, audio: Blob | AudioBuf
   let decoded: DecodedAudio;
   try {
     status('Decoding audio…', true);
-    decoded = await decodeAudio(await audioInput(audio), engine.manifest.audio.sample_rate, signal);
+    decoded = await decodeAudio(await audioInput(audio, signal), engine.manifest.audio.sample_rate, signal); // (stop() ends a download too)
   } catch (e) {
     throw new TakeError('audio', `the audio could not be read: ${(e as Error).message}`);
   }

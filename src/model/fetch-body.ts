@@ -23,6 +23,8 @@ export interface FetchedBody {
 export interface FetchBodyOptions {
   fetch?: typeof fetch;
   stallSeconds?: number;
+  /** Cancels the download: it rejects with the signal's reason at once. */
+  signal?: AbortSignal;
 }
 
 /** The response to `url` and its whole body; StalledError once nothing has arrived for `stallSeconds`; fetch's own errors as they are. */
@@ -38,6 +40,9 @@ export async function fetchBody(url: string | URL, options: FetchBodyOptions = {
   const said = `nothing arrived for ${seconds} s; check the connection and try again`;
   const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(said)), { once: true }));
   stalled.catch(() => undefined); // deliberate: read in the races below, or never needed once the body is in
+  const cancel = (): void => abort.abort(); // (the races then end, and the catch gives the caller's reason)
+  options.signal?.throwIfAborted();
+  options.signal?.addEventListener('abort', cancel, { once: true });
   try {
     // A fetch that ignores the signal (a page's own fetch function) still cannot hang: the race ends it.
     const r = await Promise.race([fetchFn(url, { signal: abort.signal }), stalled]);
@@ -59,8 +64,10 @@ export async function fetchBody(url: string | URL, options: FetchBodyOptions = {
     for (const c of chunks) bytes.set(c, (o += c.length) - c.length);
     return { ok: true, status: r.status, bytes: bytes.buffer };
   } catch (e) {
+    if (options.signal?.aborted) throw options.signal.reason;
     throw abort.signal.aborted ? new StalledError(said) : e;
   } finally {
     clearTimeout(timer);
+    options.signal?.removeEventListener('abort', cancel);
   }
 }

@@ -136,6 +136,24 @@ test('a call that fails beside a speak() under way leaves stop() able to cancel 
   expect(await page.evaluate(statusOf('right'))).toMatch(/^Played/);
 });
 
+test('stop() during speak(url)\'s download ends it: speak() resolves at once, not when the download would', async ({ page }) => {
+  test.setTimeout(60_000);
+  await page.route('**/examples/slow-speech.wav', () => undefined); // never answered (a slow host)
+  await page.goto('/examples/embed.html');
+  await expect.poll(() => page.evaluate(statusOf('left')), { timeout: 60_000 }).toContain('Ready');
+  const stopped = await page.evaluate(async () => {
+    const left = document.getElementById('left') as unknown as { speak(a: string): Promise<void>; stop(): void };
+    const spoken = left.speak('/examples/slow-speech.wav');
+    await new Promise((r) => setTimeout(r, 500));
+    const t0 = performance.now();
+    left.stop();
+    await spoken;
+    return { ms: performance.now() - t0, status: document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent };
+  });
+  expect(stopped.ms).toBeLessThan(1000);
+  expect(stopped.status).toBe('Stopped.');
+});
+
 test('one element\'s backend attribute leaves the others\' engines alone; a bad value warns and means auto', async ({ page }) => {
   test.setTimeout(180_000);
   await page.addInitScript(WATCH);

@@ -44,6 +44,20 @@ describe('fetchBody', () => {
     await expect(fetchBody('http://test/a', { fetch: aborting, stallSeconds: 0.1 })).rejects.toThrow(StalledError);
   });
 
+  it('is cancelled by its signal at once, whether the headers or the body are awaited, with the signal\'s reason', async () => {
+    for (const fetchFn of [(() => never()) as unknown as typeof fetch, served(() => streaming(2, 0, false))]) {
+      const stop = new AbortController();
+      const fetching = fetchBody('http://test/a', { fetch: fetchFn, stallSeconds: 30, signal: stop.signal });
+      setTimeout(() => stop.abort(new DOMException('stopped', 'AbortError')), 20);
+      const t0 = Date.now();
+      await expect(fetching).rejects.toThrow('stopped');
+      expect(Date.now() - t0).toBeLessThan(1000);
+    }
+    const gone = new AbortController();
+    gone.abort();
+    await expect(fetchBody('http://test/a', { fetch: served(() => streaming(1, 0, true)), signal: gone.signal })).rejects.toMatchObject({ name: 'AbortError' });
+  });
+
   it('says an HTTP error without reading its body, and passes fetch\'s own errors on', async () => {
     const missing = await fetchBody('http://test/a', { fetch: served(() => new Response('gone', { status: 404 })) });
     expect([missing.ok, missing.status, missing.bytes.byteLength]).toEqual([false, 404, 0]);
