@@ -4,7 +4,7 @@ import type { LiveSession } from '../engine/live';
 import { openMicrophone } from '../audio/capture';
 import { frameOptions } from './attributes';
 import { liveFrameDetail, type FrameDetail, type TalkingFaceErrorDetail } from './events';
-import type { WorkHost } from './work-host';
+import { NO_FACE, type WorkHost } from './work-host';
 
 /**
  * Open the microphone and animate it live: the session, or null when the work was stopped meanwhile (the microphone
@@ -14,6 +14,9 @@ import type { WorkHost } from './work-host';
 export async function listenLive(host: WorkHost, lost: (stage: TalkingFaceErrorDetail['stage'], message: string) => void, deviceId?: string): Promise<LiveSession | null> {
   const engine = await host.engine;
   if (!engine || !host.current()) return null; // stopped (or removed) while the model loaded: the microphone stays closed
+  const shown = await host.settled(); // an avatar may still be loading
+  if (!host.current()) return null;
+  if (!shown) throw host.fail('avatar', NO_FACE); // not in the page, or no avatar: the microphone is not opened for nothing
   let media: MediaStream;
   try {
     media = await openMicrophone(deviceId);

@@ -20,7 +20,7 @@ import type { PlayerView } from '../player/player';
 import { SpeechStream, type MediaSpeechStream } from '../player/speech-stream';
 import { checkedStreamOptions, type SpeechStreamOptions, type WrittenSpeechOptions } from '../player/stream-options';
 import { listenLive } from './microphone';
-import { elementStreamHost, type WorkHost } from './work-host';
+import { elementStreamHost, NO_FACE, type WorkHost } from './work-host';
 import { playbackFrameDetail, readyDetail, TalkingFaceError, type FrameDetail, type ReadyDetail, type TalkingFaceErrorDetail } from './events';
 
 export type { FrameDetail, ReadyDetail, TalkingFaceErrorDetail } from './events';
@@ -137,6 +137,7 @@ export class TalkingFaceElement extends ElementBase {
     const { gen, signal } = this.begin();
     const engine = await unlessAborted(this.load(), signal);
     if (!engine || gen !== this.generation) return; // stopped (or removed) while the model loaded
+    if (!this.isConnected) throw this.fail('avatar', NO_FACE, gen); // (not animated for nothing)
     let take: ElementTake;
     try {
       take = await makeTake(engine, audio, this, signal, (text, announce) => gen === this.generation && this.status.set(text, false, announce));
@@ -147,7 +148,7 @@ export class TalkingFaceElement extends ElementBase {
     [this.computeMs, this.audioSeconds] = [take.computeMs, take.seconds];
     const player = await this.stage.settled(); // an avatar may still be loading
     if (gen !== this.generation) return;
-    if (!player) throw this.fail('avatar', this.stage.error ?? 'there is no face to show it on (is the element in the page?)', gen);
+    if (!player) throw this.fail('avatar', this.stage.error ?? NO_FACE, gen);
     this.work = null; // animated: stop() from here stops the playback
     this.animation = take.animation;
     player.load(take.animation, take.decoded.buffer);
@@ -252,6 +253,8 @@ export class TalkingFaceElement extends ElementBase {
         (engine) => {
           if (this.hold !== hold) return engine; // released meanwhile (removed, or another model or backend)
           this.engine = engine;
+          // Not in the page (speak() or `ready` before it was added): not held, as no disconnectedCallback would let go.
+          if (!this.isConnected) queueMicrotask(() => !this.isConnected && this.hold === hold && this.letGo());
           // A retry (speak() or startMicrophone() after a failed load): no connectedCallback will show the face.
           if (this.retrying) void this.afterLoad(false, false);
           this.retrying = false;

@@ -5,6 +5,9 @@ import type { StreamHost, StreamTake } from '../player/stream-options';
 import { frameOptions } from './attributes';
 import { streamFrameDetail, type FrameDetail, type TalkingFaceErrorDetail } from './events';
 
+/** Why work that needs the face cannot be shown: the element is not in the page (or its avatar failed, which it has said). */
+export const NO_FACE = 'there is no face to show it on (is the element in the page?)';
+
 export interface WorkHost {
   /** The engine, once loaded (null: stopped meanwhile; rejects when it cannot be loaded, which the element has reported). */
   engine: Promise<TalkingFaceEngine | null>;

@@ -218,7 +218,21 @@ test('removed from the page, the elements free their engine (onnxruntime\'s work
     g.parked = ['left', 'right'].map((id) => document.getElementById(id)!);
     for (const el of g.parked) el.remove();
   });
-  await page.waitForTimeout(5_000);
+  // A removed element's late calls (a route gone, its speech service answering after): refused at once, saying why;
+  // they neither open the microphone nor keep the engine.
+  await page.waitForTimeout(2_000);
+  const late = await page.evaluate(async () => {
+    const [left, right] = (globalThis as unknown as { parked: (HTMLElement & { speak(a: string): Promise<void>; startMicrophone(): Promise<void> })[] }).parked;
+    const t0 = performance.now();
+    const spoke = await left.speak('/examples/sample.wav').then(() => 'spoke', (e: Error) => e.message);
+    const listened = await right.startMicrophone().then(() => 'listening', (e: Error) => e.message);
+    return { spoke, listened, ms: performance.now() - t0, asked: (globalThis as unknown as { microphoneRequests: number }).microphoneRequests };
+  });
+  expect(late.spoke).toBe('there is no face to show it on (is the element in the page?)');
+  expect(late.listened).toBe('there is no face to show it on (is the element in the page?)');
+  expect(late.asked, 'no microphone opened for a removed element').toBe(0);
+  expect(late.ms, 'refused before any animating').toBeLessThan(2_000);
+  await page.waitForTimeout(3_000);
   expect(names().length, 'kept a while (an element put back soon takes it back)').toBe(working);
   await expect.poll(() => names().length, { timeout: 30_000, message: `workers left: ${names().join(', ')}` }).toBe(0);
   // Put back: loads again, and speaks.
@@ -226,7 +240,7 @@ test('removed from the page, the elements free their engine (onnxruntime\'s work
   await expect.poll(async () => (await readies('left')) + (await readies('right')), { timeout: 60_000 }).toBe(4);
   await page.locator('#speak').click();
   await expect.poll(async () => (await events()).left?.filter((e) => e === 'ended').length ?? 0, { timeout: 60_000 }).toBe(1);
-  expect((await events()).left).not.toContain('error');
+  expect((await events()).left).not.toContain('error'); // (the late call's was sent while out of the page: not seen here)
 });
 
 test('removed elements give their WebGL context back at once: 18 shown and removed, held by the page, none evicted', async ({ page }) => {
