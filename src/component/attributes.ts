@@ -26,6 +26,21 @@ export function avatarAttributes(el: Element): { headBone: string | null; facing
 }
 
 /**
+ * What an element's face is made from, as it means it: the model (`defaultModel` where none is named), template,
+ * backend ('auto' where none), avatar and its head bone and facing. The same again: nothing to load again.
+ */
+export function loadKey(el: Element, defaultModel: string): string[] {
+  const a = (name: string) => el.getAttribute(name)?.trim() ?? '';
+  return [a('model') || defaultModel, a('template'), a('backend') || 'auto', a('avatar'), a('avatar-head-bone'), a('avatar-facing')];
+}
+
+/** What differs between two loadKeys: the model or template, else the avatar, else the backend only; or null. */
+export function loadChange(was: string[], now: string[]): 'model' | 'avatar' | 'backend' | null {
+  const changed = (from: number, to: number) => now.slice(from, to).some((v, i) => v !== was[from + i]);
+  return changed(0, 2) ? 'model' : changed(3, 6) ? 'avatar' : changed(2, 3) ? 'backend' : null;
+}
+
+/**
  * Whether a boolean attribute is on: present, and not "false" (React 18 writes `autoplay={false}` as
  * autoplay="false"; the HTML way, absent, is off too).
  */

@@ -1,16 +1,14 @@
 /**
- * <talking-face>: the whole thing as one custom element (shadow DOM). docs/embedding.md.
- *   <script type="module" src="/lib/talking-face.js"></script>  <talking-face src="/hello.wav" autoplay></talking-face>
- * Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven instead of the face),
- * avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1). Methods: speak(audio), speakStream(options),
- * startMicrophone(), stop(), recordVideo(). Events: ready, frame, ended, error (detail.message is written for a person).
- * Instances with the same model and backend share one engine.
+ * <talking-face>: the whole thing as one custom element (shadow DOM); docs/embedding.md. Instances with the same model
+ * and backend share one engine. Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven
+ * instead of the face), avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1), muted. Methods:
+ * speak(audio), speakStream(options), startMicrophone(), stop(), recordVideo(). Events: ready, frame, ended, error.
  */
 import { AvatarView } from '../avatar/avatar-view';
 import type { GltfAvatar } from '../avatar/gltf-avatar';
 import type { Animation, Backend, Frames, TalkingFaceEngine } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
-import { avatarAttributes, backendAttribute, frameOptions, isOn, reflect } from './attributes';
+import { avatarAttributes, backendAttribute, frameOptions, isOn, loadChange, loadKey, reflect } from './attributes';
 import { makeTake, TakeError, type ElementTake } from './take';
 import { shadowParts, type StatusLine } from './parts';
 import { ElementStage, CONTEXT_LOST } from './stage';
@@ -50,6 +48,7 @@ export class TalkingFaceElement extends ElementBase {
   private playingStatus = '';
   private connected = false; // connectedCallback has run once
   private retrying = false; // the last load failed: the next to succeed shows the face itself
+  private made: string[] = []; // what the face loaded or loading is made from (loadKey)
   private autoplayed = false; // this model's `src` has been autoplayed (or was not to be): another avatar does not again
 
   constructor() {
@@ -91,8 +90,9 @@ export class TalkingFaceElement extends ElementBase {
   set avatar(url: string | null) { reflect(this, 'avatar', url); }
 
   connectedCallback(): void {
-    if (this.stage.view && this.engine) return; // moved within the page (disconnectedCallback kept everything)
-    [this.connected, this.retrying] = [true, false]; // this call shows the face once loaded
+    // Moved within the page (disconnectedCallback kept everything): it goes on, unless changed while out of it.
+    if (this.stage.view && this.engine) return this.refresh();
+    [this.connected, this.retrying, this.made] = [true, false, loadKey(this, DEFAULT_MODEL)]; // this call shows the face once loaded
     void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() has reported the failure (status line, `error` event)
   }
 
@@ -111,16 +111,7 @@ export class TalkingFaceElement extends ElementBase {
     // Before the first connectedCallback (an upgrade calls this first, for every attribute) that call reads them all.
     if (old === value || !this.isConnected || !this.connected) return;
     if (name === 'model' || name === 'template' || name.startsWith('avatar') || name === 'backend') {
-      // Elements share an engine per model, template and backend: a new backend takes the engine of its backend
-      // (the others keep theirs) and keeps its view; `ready` tells the new backend. Another avatar or backend autoplays
-      // `src` only if it had not been yet (the same speech); another model or template, again.
-      if (name === 'model' || name === 'template') this.autoplayed = false;
-      const anew = name !== 'backend';
-      this.stop();
-      this.letGo();
-      this.retrying = false;
-      if (anew) this.stage.drop();
-      void this.load().then(() => this.afterLoad(!this.autoplayed), () => undefined); // deliberate: load() reports its failure
+      this.refresh();
     } else if (name === 'src' && value) { // set while the model loads: spoken once it is in
       void this.speak(value).catch(() => undefined); // speak() has reported it (status line, `error` event)
     } else if (name === 'live' && (this.engine || this.retrying)) { // (retrying: a failed load is tried again)
@@ -221,6 +212,18 @@ export class TalkingFaceElement extends ElementBase {
     this.halt(true);
   }
 
+  /** Load again what the attributes changed (loadKey: nothing if they mean the same). Another backend takes its shared
+   * engine and keeps the view; `src` autoplays again for another model or template, else only if it had not yet. */
+  private refresh(): void {
+    const change = loadChange(this.made, (this.made = loadKey(this, DEFAULT_MODEL)));
+    if (!change) return;
+    if (change === 'model') this.autoplayed = false;
+    this.stop();
+    this.letGo();
+    if (change !== 'backend') this.stage.drop();
+    void this.load().then(() => this.afterLoad(!this.autoplayed), () => undefined); // deliberate: load() reports its failure
+  }
+
   /** Stop what runs; `say`: tell it in the status line (not when new work takes its place: that work speaks). */
   private halt(say: boolean): void {
     this.generation++;
@@ -273,7 +276,7 @@ export class TalkingFaceElement extends ElementBase {
   /** Release the engine (another load takes one anew). */
   private letGo(): void {
     this.hold?.release();
-    [this.hold, this.loading, this.engine] = [null, null, null];
+    [this.hold, this.loading, this.engine, this.retrying] = [null, null, null, false];
   }
 
   /**

@@ -195,6 +195,19 @@ test('an element moved in the page (removed and put back at once) goes on: no ne
   const stats = await imageStats(page, await page.locator('#left').screenshot());
   expect(stats.foregroundFraction, 'the moved face is drawn').toBeGreaterThan(0.1);
   expect(gl, 'WebGL messages').toEqual([]);
+  // Attributes that mean what is loaded load nothing again (an empty model is the default one, as absent).
+  await page.evaluate(() => document.getElementById('left')!.setAttribute('model', ''));
+  await page.waitForTimeout(1_000);
+  expect((await events()).left?.filter((e) => e.startsWith('ready'))).toHaveLength(1);
+  // Changed while out of the page, in the same task as the move (a framework re-parenting it): loaded as changed.
+  await page.evaluate(() => {
+    const left = document.getElementById('left')!;
+    left.remove();
+    left.setAttribute('avatar', '/examples/avatars/arkit-face.glb');
+    document.querySelector('.pair')!.prepend(left);
+  });
+  await expect.poll(async () => (await events()).left?.filter((e) => e.startsWith('ready')).length, { timeout: 60_000 }).toBe(2);
+  expect(await page.locator('#left').evaluate((el) => (el as unknown as { avatar: { summary: { scheme: string } } | null }).avatar?.summary.scheme)).toBe('arkit');
 });
 
 test('removed from the page, the elements free their engine (onnxruntime\'s worker, the decoder workers); put back, they load again', async ({ page }) => {

@@ -1,5 +1,5 @@
 import { afterEach, describe, expect, it, vi } from 'vitest';
-import { audioInput, avatarAttributes, backendAttribute, frameOptions, headMotionAttribute, isOn } from '../../../src/component/attributes';
+import { audioInput, avatarAttributes, backendAttribute, frameOptions, headMotionAttribute, isOn, loadChange, loadKey } from '../../../src/component/attributes';
 
 describe('<talking-face> attributes', () => {
   afterEach(() => vi.unstubAllGlobals());
@@ -14,6 +14,19 @@ describe('<talking-face> attributes', () => {
     expect(backendAttribute('gpu')).toBe('auto');
     expect(warn).toHaveBeenCalledWith(expect.stringContaining('backend="gpu"'));
     warn.mockRestore();
+  });
+
+  it('what the face is made from: values that mean the same load nothing again; a change says what to load', () => {
+    const el = (attrs: Record<string, string>) => ({ getAttribute: (n: string) => attrs[n] ?? null }) as unknown as Element;
+    const key = (attrs: Record<string, string>) => loadKey(el(attrs), '/models/manifest.json');
+    const plain = key({});
+    expect(loadChange(plain, key({ model: '', backend: 'auto' }))).toBeNull(); // (absent and these mean the same)
+    expect(loadChange(plain, key({ model: ' /models/manifest.json ' }))).toBeNull();
+    expect(loadChange(plain, key({ backend: 'cpu' }))).toBe('backend');
+    expect(loadChange(plain, key({ avatar: '/a.glb', backend: 'cpu' }))).toBe('avatar');
+    expect(loadChange(plain, key({ 'avatar-facing': '-z' }))).toBe('avatar');
+    expect(loadChange(plain, key({ template: '/t.json', avatar: '/a.glb' }))).toBe('model');
+    expect(loadChange(plain, key({ model: '/other/manifest.json' }))).toBe('model');
   });
 
   it('a boolean attribute is on when present and not "false" (React 18 writes autoplay={false} as "false")', () => {
