@@ -258,8 +258,8 @@ export class TalkingFaceElement extends ElementBase {
           this.engine = engine;
           // Not in the page (speak() or `ready` before it was added): not held, as no disconnectedCallback would let go.
           if (!this.isConnected) queueMicrotask(() => !this.isConnected && this.hold === hold && this.letGo());
-          // A retry (speak() or startMicrophone() after a failed load): no connectedCallback will show the face.
-          if (this.retrying) void this.afterLoad(false, false);
+          // A retry (`ready`, speak() or startMicrophone() after a failed load): no connectedCallback will show the face.
+          if (this.retrying) void this.afterLoad(!this.autoplayed, !this.work); // (`live` and `src` start unless work retried)
           this.retrying = false;
           return engine;
         },
