@@ -166,7 +166,7 @@ function openSample(name: string): Promise<void> {
   if (!c) return Promise.resolve();
   return animateTake('the sample', async (e, signal) => {
     showStatus(`Loading the sample "${c.text}"…`);
-    const { audio: bytes, truth } = await fetchSample(c, view.template.vertexCount, e.unitsPerMm);
+    const { audio: bytes, truth } = await fetchSample(c, view.template.vertexCount, e.unitsPerMm, signal);
     const audio = await decodeAudio(bytes, e.manifest.audio.sample_rate);
     ui.clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}".`;
     const { animation, computeMs, samples, notes } = await animateAudio(e, 'the sample', audio.samples, c.seconds, signal);

@@ -3,6 +3,7 @@
  * audio and the ground truth of test-split clips, checked against the index's hashes.
  */
 import { sha256Hex } from '../model/artefacts';
+import { fetchBody } from '../model/fetch-body';
 
 const SAMPLES_URL = '/models/samples/';
 
@@ -28,10 +29,17 @@ export interface Truth {
   phones?: [string, number, number][];
 }
 
+/** A sample file's bytes (a stalled download fails, naming it; `signal` cancels). */
+async function sampleFile(name: string, signal?: AbortSignal): Promise<ArrayBuffer> {
+  const r = await fetchBody(`${SAMPLES_URL}${name}`, { signal }).catch((e: Error) => {
+    throw signal?.aborted ? e : new Error(`${name}: ${e.message}`);
+  });
+  if (!r.ok) throw new Error(`${name === 'index.json' ? '' : `${name}: `}HTTP ${r.status}`);
+  return r.bytes;
+}
+
 export async function fetchSampleIndex(): Promise<SampleIndex> {
-  const res = await fetch(`${SAMPLES_URL}index.json`);
-  if (!res.ok) throw new Error(`HTTP ${res.status}`);
-  return res.json();
+  return JSON.parse(new TextDecoder().decode(await sampleFile('index.json'))) as SampleIndex;
 }
 
 /** Fill the demo's sample menu from the index; without one the menu is disabled, its title saying why. */
@@ -58,12 +66,8 @@ export function markSample(select: HTMLSelectElement, index: SampleIndex | null,
 }
 
 /** A sample's audio bytes and decoded ground truth, both checked against the index. */
-export async function fetchSample(c: SampleEntry, vertices: number, unitsPerMm: number): Promise<{ audio: ArrayBuffer; truth: Truth }> {
-  const [audio, truthBytes] = await Promise.all([c.audio, c.ground_truth].map(async (f) => {
-    const r = await fetch(`${SAMPLES_URL}${f}`);
-    if (!r.ok) throw new Error(`${f}: HTTP ${r.status}`);
-    return r.arrayBuffer();
-  }));
+export async function fetchSample(c: SampleEntry, vertices: number, unitsPerMm: number, signal?: AbortSignal): Promise<{ audio: ArrayBuffer; truth: Truth }> {
+  const [audio, truthBytes] = await Promise.all([c.audio, c.ground_truth].map((f) => sampleFile(f, signal)));
   if ((await sha256Hex(audio)) !== c.audio_sha256 || (await sha256Hex(truthBytes)) !== c.ground_truth_sha256) {
     throw new Error('the sample files do not match their index (corrupt download?)');
   }

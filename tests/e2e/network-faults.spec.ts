@@ -105,6 +105,23 @@ test('the demo served without sample clips offers only what there is', async ({ 
   await expect(page.locator('#sample-select')).toHaveAttribute('title', 'No sample clips: HTTP 404');
 });
 
+test('the demo\'s sample whose download hangs: Escape stops it at once, and another sample opens', async ({ page, context }) => {
+  test.setTimeout(90_000);
+  let hung = '';
+  await context.route('**/models/samples/*.wav', (route) => (hung === '' || route.request().url().endsWith(hung)
+    ? (hung ||= route.request().url().split('/').pop()!, undefined) : route.continue())); // the first clip's audio never comes
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 60_000 });
+  const options = page.locator('#sample-select option');
+  await page.locator('#sample-select').selectOption((await options.nth(1).getAttribute('value'))!);
+  await expect(page.locator('#status')).toContainText('Loading the sample');
+  await page.waitForTimeout(500);
+  await page.keyboard.press('Escape');
+  await expect(page.locator('#status')).toContainText('Stopped animating the sample', { timeout: 2_000 });
+  await page.locator('#sample-select').selectOption((await options.nth(2).getAttribute('value'))!);
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+});
+
 test('the library finds its workers beside itself (lib/assets/), not at the site root where only the demo has copies', async ({ page, context }) => {
   test.setTimeout(60_000);
   // Deployed as docs/embedding.md says: lib/, models/ and ort/, no /assets/ at the root.
