@@ -72,9 +72,10 @@ export class AvatarView {
     this.loop();
   }
 
-  /** Fetch, parse and show the avatar at `url` (AvatarLoadError says what is wrong with it). */
-  static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null, options: AvatarBindOptions = {}): Promise<AvatarView> {
-    const res = await fetchBody(url).catch((e: Error) => {
+  /** Fetch, parse and show the avatar at `url` (AvatarLoadError says what is wrong with it); `signal` stops the download. */
+  static async load(canvas: HTMLCanvasElement, url: string, headBone?: string | null, options: AvatarBindOptions = {}, signal?: AbortSignal): Promise<AvatarView> {
+    const res = await fetchBody(url, { signal }).catch((e: Error) => {
+      if (signal?.aborted) throw e;
       const other = new URL(url, location.href).origin !== location.origin;
       const hint = other && !(e instanceof StalledError) ? ' (another origin: does it send CORS headers?)' : '';
       throw new Error(`could not fetch the avatar ${url}: ${e.message}${hint}`);

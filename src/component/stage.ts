@@ -25,7 +25,7 @@ export class ElementStage {
   undrawn: string | null = null;
   private loudness = 1;
   private silenced = false;
-  private token = {};
+  private token = new AbortController(); // the view being made: aborted when superseded (its avatar's download stops)
   private made: Promise<unknown> = Promise.resolve();
 
   /** `onContext(true)`: the browser took the view's WebGL context (it keeps 16 a page); `onContext(false)`: it gave it back. */
@@ -38,7 +38,8 @@ export class ElementStage {
    * a person (kept in `error`). Where the page has no WebGL, the view draws nothing (`undrawn` says why).
    */
   async make(template: FaceTemplate, unitsPerMm: number, avatar: string | null, bound: { headBone: string | null; facing: '+z' | '-z' | undefined }): Promise<boolean> {
-    const token = (this.token = {});
+    this.token.abort();
+    const token = (this.token = new AbortController());
     const root = this.canvas.getRootNode() as ShadowRoot; // the element's
     const canvas = newCanvas(root.host);
     const focused = root.activeElement === this.canvas;
@@ -50,7 +51,7 @@ export class ElementStage {
     canvas.addEventListener('webglcontextlost', () => canvas === this.canvas && this.view && this.onContext(true));
     canvas.addEventListener('webglcontextrestored', () => canvas === this.canvas && this.view && this.onContext(false));
     this.undrawn = webglAvailable() ? null : `${avatar ? 'the avatar' : 'the face'} is not shown: ${NO_WEBGL}`;
-    const made: Promise<FaceView | AvatarView | SoundOnlyView> = this.undrawn ? Promise.resolve(new SoundOnlyView()) : avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, bound.headBone, { facing: bound.facing })
+    const made: Promise<FaceView | AvatarView | SoundOnlyView> = this.undrawn ? Promise.resolve(new SoundOnlyView()) : avatar ? AvatarView.load(canvas, new URL(avatar, document.baseURI).href, bound.headBone, { facing: bound.facing }, token.signal)
       : Promise.resolve().then(() => new FaceView(canvas, template));
     this.made = made;
     let view: FaceView | AvatarView | SoundOnlyView;
@@ -105,7 +106,8 @@ export class ElementStage {
 
   /** Stop drawing and playing: the view and its player disposed, a view still loading not shown. */
   drop(): void {
-    [this.token, this.error, this.undrawn] = [{}, null, null];
+    this.token.abort();
+    [this.token, this.error, this.undrawn] = [new AbortController(), null, null];
     this.player?.dispose();
     this.player = null;
     this.view?.dispose();

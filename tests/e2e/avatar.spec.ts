@@ -220,6 +220,22 @@ test('an avatar file that is not glTF, or has neither naming scheme, gives a cle
   expect(await errorOf(await blobUrl(Buffer.from(draco).toString('base64')))).toMatch(/^avatar: the avatar cannot be used: blob:.* is compressed with Draco \(KHR_draco_mesh_compression\), which this library does not decode/);
 });
 
+test('an avatar replaced while its download hangs: the download is stopped, and the new one shown', async ({ page }) => {
+  test.setTimeout(90_000);
+  await page.route('**/examples/avatars/hung.glb', () => undefined); // never answered (a slow host)
+  const [asked, stopped]: string[][] = [[], []];
+  page.on('request', (r) => r.url().endsWith('hung.glb') && asked.push(r.url()));
+  page.on('requestfailed', (r) => r.url().endsWith('hung.glb') && stopped.push(r.failure()?.errorText ?? '?'));
+  await page.goto('/examples/embed.html');
+  await page.locator('#left').evaluate((el) => el.setAttribute('avatar', '/examples/avatars/hung.glb'));
+  await expect.poll(() => page.evaluate(() => document.getElementById('left')!.shadowRoot!.querySelector('p.status')!.textContent), { timeout: 60_000 }).toContain('Loading the avatar');
+  const ready = page.locator('#left').evaluate((el) => new Promise<string>((resolve) => el.addEventListener('ready', (e) => resolve((e as CustomEvent).detail.avatar?.scheme), { once: true })));
+  await page.locator('#left').evaluate((el) => el.setAttribute('avatar', '/examples/avatars/arkit-face.glb'));
+  expect(await ready).toBe('arkit');
+  expect(asked.length).toBeGreaterThan(0);
+  await expect.poll(() => stopped, { timeout: 5_000, message: 'every download of the replaced avatar stopped' }).toEqual(asked.map(() => 'net::ERR_ABORTED'));
+});
+
 test('avatar-facing="-z" shows an avatar made facing -z (VRM 0.x) as a +z one', async ({ page }) => {
   test.setTimeout(120_000);
   await page.emulateMedia({ reducedMotion: 'reduce' }); // no idle blinks: the pictures compare as they are
