@@ -10,6 +10,7 @@ import { OnnxModel, type ExecutionProvider } from './onnx-model';
 import { specOf } from './onnx-spec';
 import { melFlatness, speechProbabilities } from './voice-activity';
 import { melBandWidths } from '../audio/mel';
+import { allOrFree } from '../model/all-or-free';
 
 /** Content frames [lo, hi) and the Mel frames [melLo, melHi) that compute them exactly. */
 export interface ContentRange {
@@ -43,7 +44,7 @@ export class ContentEncoder {
   }
 
   static async create(manifest: Manifest, files: Record<string, ArrayBuffer | Promise<ArrayBuffer>>, providers: ExecutionProvider[]): Promise<ContentEncoder> {
-    const [content, hierarchical] = await Promise.all([
+    const [content, hierarchical] = await allOrFree([ // (one session failing frees the other)
       Promise.resolve(files.content_encoder).then((bytes) => OnnxModel.create(specOf(manifest, 'content_encoder', bytes), providers)),
       Promise.resolve(files.hierarchical).then((bytes) => OnnxModel.create(specOf(manifest, 'hierarchical', bytes), providers)),
     ]);

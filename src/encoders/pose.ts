@@ -6,6 +6,7 @@
 import type { Manifest } from '../model/manifest';
 import { OnnxModel, type ExecutionProvider } from './onnx-model';
 import { specOf } from './onnx-spec';
+import { allOrFree } from '../model/all-or-free';
 
 /** What carries from one chunk to the next: the LSTM's state and the pose features still needed. */
 export interface PoseState {
@@ -26,7 +27,7 @@ export class PoseEncoder {
   ) {}
 
   static async create(manifest: Manifest, files: Record<string, ArrayBuffer | Promise<ArrayBuffer>>, providers: ExecutionProvider[]): Promise<PoseEncoder> {
-    const [conv, lstm] = await Promise.all([
+    const [conv, lstm] = await allOrFree([ // (one session failing frees the other)
       Promise.resolve(files.pose_conv).then((bytes) => OnnxModel.create(specOf(manifest, 'pose_conv', bytes), providers)),
       Promise.resolve(files.pose_lstm).then((bytes) => OnnxModel.create(specOf(manifest, 'pose_lstm', bytes), providers)),
     ]);

@@ -114,15 +114,19 @@ export class DecoderBackends {
       }
     }
     if (this.disposed) throw new EngineDisposedError(); // its WebGPU buffers destroyed under the decode above
-    if (this.pool && frames > 1) {
+    const pool = this.pool;
+    if (pool && frames > 1) {
       try {
-        return await this.pool.decode(latents, poseToken, frames);
+        return await pool.decode(latents, poseToken, frames);
       } catch (e) {
         if (this.disposed) throw new EngineDisposedError(); // terminated by dispose(), not crashed
-        // A crashed worker: decode in this thread from now on (same numbers), and say so.
-        this.pool.terminate();
-        this.pool = null;
-        this.reason += `; the decoder workers failed (${(e as Error).message}), decoding in the page's thread`;
+        // A crashed worker: decode in this thread from now on (same numbers), and say so (once: decodes under way
+        // together all fail with it).
+        if (this.pool === pool) {
+          pool.terminate();
+          this.pool = null;
+          this.reason += `; the decoder workers failed (${(e as Error).message}), decoding in the page's thread`;
+        }
       }
     }
     return this.cpu.decodeLatents(latents, poseToken, frames);

@@ -35,3 +35,22 @@ export function checkedBackend(backend: unknown): 'auto' | Backend {
   if (backend === 'auto' || backend === 'cpu' || backend === 'webgpu') return backend;
   throw new RangeError(`backend must be 'auto', 'cpu' or 'webgpu', not ${JSON.stringify(backend)}`);
 }
+
+/** Most decoder workers a page may ask for: more than any core count a browser reports for a page's use. */
+const MAX_CPU_WORKERS = 64;
+
+/** load()'s cpuWorkers: a whole number from 0 to MAX_CPU_WORKERS (0 or 1: the page's thread). */
+export function checkedWorkers(workers: unknown): number {
+  if (typeof workers !== 'number' || !Number.isInteger(workers) || workers < 0 || workers > MAX_CPU_WORKERS) {
+    throw new RangeError(`cpuWorkers must be a whole number from 0 to ${MAX_CPU_WORKERS}, not ${JSON.stringify(workers) ?? String(workers)}`);
+  }
+  return workers;
+}
+
+/** attentionAt()'s layer: 0 to layers - 1 (the decoder's layers count from 0). */
+export function checkedLayer(layer: unknown, layers: number): number {
+  if (typeof layer !== 'number' || !Number.isInteger(layer) || layer < 0 || layer >= layers) {
+    throw new RangeError(`layer must be a whole number from 0 to ${layers - 1} (the decoder's layers count from 0), not ${JSON.stringify(layer) ?? String(layer)}`);
+  }
+  return layer;
+}

@@ -19,7 +19,7 @@ import { ReferenceDecoder, decoderWeights, type AttentionMaps, type DecoderWeigh
 import { HeadMotion, checkedScale, headMotionParams } from '../pose/head-motion';
 import { detectWebGPU, isHardwareAdapter } from '../gpu/capabilities';
 import type { FaceTemplate } from '../template/face-template';
-import { DecoderBackends, type Backend } from './backends';
+import { DecoderBackends, EngineDisposedError, type Backend } from './backends';
 import type { AvatarWeights } from '../avatar/weights';
 import { DEFAULT_CHUNK_FRAMES, Pipeline } from './pipeline';
 import { StreamSession } from './stream';
@@ -27,8 +27,9 @@ import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
 import { levels, SILENT_PEAK } from '../audio/decode';
-import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from './checks';
+import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedWorkers } from './checks';
 import { ortThreads } from '../encoders/ort-worker-client';
+import { allOrFree } from '../model/all-or-free';
 
 export type { Backend } from './backends';
 export type { Animation, Frames, StageTimes } from './frames';
@@ -56,6 +57,7 @@ export class TalkingFaceEngine {
 
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
     if (options.backend !== undefined) checkedBackend(options.backend);
+    if (options.cpuWorkers !== undefined) checkedWorkers(options.cpuWorkers);
     // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
@@ -75,7 +77,7 @@ export class TalkingFaceEngine {
       return { decoder: decoderWeights(tensors, m, manifest.model.layer_norm_eps), head: headMotionParams(tensors, m) };
     });
     const decoders = Promise.all([template, weights]).then(([t, w]) => DecoderBackends.create(w.decoder, t.adjacency, m, support, DEFAULT_CHUNK_FRAMES, options));
-    const [content, pose, decoder, face, { head }] = await Promise.all([
+    const [content, pose, decoder, face, { head }] = await allOrFree([ // (a part failing frees the others: sessions, workers)
       ContentEncoder.create(manifest, files, providers),
       PoseEncoder.create(manifest, files, providers),
       decoders,
@@ -216,6 +218,7 @@ export class TalkingFaceEngine {
   async attentionAt(samples: Float32Array, frame: number, layer = this.manifest.model.config.layers - 1): Promise<AttentionMaps> {
     const F = this.frameCount(checkedSamples(samples, 'attentionAt').length);
     const f = checkedFrame(frame, F);
+    checkedLayer(layer, this.manifest.model.config.layers);
     const inputs: { tokens?: Float32Array; poseToken?: Float32Array } = {};
     await this.pipeline.produce(this.pipeline.newState(), f, f + 1, samples, 0, samples.length, inputs);
     this.reference ??= new ReferenceDecoder(this.decoderWeights, this.template.adjacency, this.manifest.model.config);
@@ -234,6 +237,7 @@ export class TalkingFaceEngine {
 
   /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
   listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
+    if (this.pipeline.disposed) return Promise.reject(new EngineDisposedError()); // (the microphone's capture not started)
     const stream = this.createStream(onFrames,
       { maxLagFrames: LiveSession.maxLag(options), blendshapes: options?.blendshapes, headMotionScale: options?.headMotionScale });
     return LiveSession.start(stream, media, options);

@@ -60,12 +60,17 @@ export class LiveSession {
     if (this.closed || this.failed) return;
     this.samples += piece.length;
     if (this.keepAudio) this.pieces.push(piece);
-    this.stream.push(piece).catch((e: Error) => {
+    const failed = (e: Error): void => {
       if (this.failed) return;
       this.failed = e;
       void this.capture?.stop();
       onError?.(e);
-    });
+    };
+    try {
+      this.stream.push(piece).catch(failed);
+    } catch (e) {
+      failed(e as Error); // (a stream cancelled meanwhile refuses at once)
+    }
   }
 
   /** Stop capturing, emit the remaining frames, and return the take (empty when keepAudio is false). */

@@ -31,7 +31,7 @@ const HOLD_FRAMES = 256;
  * What carries from one chunk to the next: the pose encoder's LSTM state and features, the head motion's last
  * residuals, and, when the frames carry ARKit weights, the solver's warm start.
  */
-export type ProducerState = PoseState & { head?: HeadMotionState; headScale?: number; blendshapes?: SolverState };
+export type ProducerState = PoseState & { head?: HeadMotionState; headScale?: number; headSeed?: number | null; blendshapes?: SolverState };
 
 /** What a new state computes besides the face: `blendshapes` (the avatar stage), and its own head-motion scale. */
 export interface StateOptions {
@@ -52,7 +52,8 @@ export class Pipeline {
   private restWeights: Promise<Float32Array> | null = null;
   private rest: Promise<{ face: Float32Array; pose: Float32Array }> | null = null;
   private closure: LipClosure | null | undefined;
-  private disposed = false;
+  /** dispose() was called: everything that runs the model is refused (EngineDisposedError). */
+  disposed = false;
 
   constructor(
     readonly manifest: Manifest,
@@ -99,6 +100,7 @@ export class Pipeline {
     const state: ProducerState = this.pose.newState();
     if (options.blendshapes) state.blendshapes = this.avatarWeights.newState();
     state.headScale = options.headMotionScale ?? this.headScale;
+    state.headSeed = this.headSeed; // (a seed set later is for later animations: this one's head does not jump)
     return state;
   }
 
@@ -226,6 +228,15 @@ export class Pipeline {
   async produce(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number,
     inputs?: { tokens?: Float32Array; poseToken?: Float32Array }): Promise<Frames> {
     if (this.disposed) throw new EngineDisposedError();
+    try {
+      return await this.frames(state, f0, f1, samples, offset, total, inputs);
+    } catch (e) {
+      throw this.disposed ? new EngineDisposedError() : e; // a session released under the work: dispose(), no failure
+    }
+  }
+
+  private async frames(state: ProducerState, f0: number, f1: number, samples: Float32Array, offset: number, total: number,
+    inputs?: { tokens?: Float32Array; poseToken?: Float32Array }): Promise<Frames> {
     const a = this.manifest.audio;
     const K = Number.isFinite(total) ? melFrameCount(total, a) : Infinity;
     const melIndex = Array.from({ length: f1 - f0 }, (_, i) => Math.min(frameToMelIndex(f0 + i, a), K - 1));
@@ -267,8 +278,9 @@ export class Pipeline {
 
     t = performance.now();
     this.lipClosure?.apply(decoded.offsets, melIndex.length, this.template.vertexCount);
-    if (this.headMotion && this.headSeed !== null) {
-      state.head ??= this.headMotion.start(this.headSeed);
+    const seed = state.headSeed === undefined ? this.headSeed : state.headSeed;
+    if (this.headMotion && seed !== null) {
+      state.head ??= this.headMotion.start(seed);
       const residual = this.headMotion.residuals(state.head, f0, poseToken, melIndex.length);
       this.headMotion.compose(decoded.pose, residual, melIndex.length, state.headScale ?? this.headScale);
     }

@@ -54,3 +54,38 @@ test('a disposed engine refuses every later call with EngineDisposedError, a res
   const refused = 'EngineDisposedError: this talking-face engine was disposed; load a new one';
   expect(outcome).toEqual({ before: [true, 52], animate: refused, restFace: refused, restArkit: refused, stream: refused, again: 'resolved' });
 });
+
+test('disposed while it animates: the animation rejects with EngineDisposedError whichever stage it was in; listen after it too', async ({ page }) => {
+  await openDemo(page);
+  const outcome = await page.evaluate(async () => {
+    const engine = (globalThis as unknown as { talkingFace: { engine: any } }).talkingFace.engine;
+    let seed = 7;
+    const voice = Float32Array.from({ length: 16000 * 10 }, (_, i) => 0.3 * Math.sin(i / 8) * ((seed = (seed * 16807) % 2147483647) / 2147483647));
+    const names: string[] = [];
+    for (const delayMs of [0, 30, 120]) { // (the first chunk's stages: a dispose lands in the encoders or the decoder)
+      const e = await (engine.constructor as { load(o: object): Promise<any> }).load({ backend: 'cpu', cpuWorkers: 0 });
+      const animating = e.animate(voice, { chunkFrames: 300 }).then(() => 'resolved', (err: Error) => err.name);
+      setTimeout(() => void e.dispose(), delayMs);
+      names.push(await animating);
+      names.push(await e.listen(new MediaStream(), () => undefined).then(() => 'listening', (err: Error) => err.name));
+    }
+    const refused = await engine.attentionAt(voice.subarray(0, 16000), 3, 3).then(() => 'resolved', (err: Error) => `${err.name}: ${err.message}`);
+    return { names, refused };
+  });
+  expect(outcome.names).toEqual(Array.from({ length: 3 }, () => ['EngineDisposedError', 'EngineDisposedError']).flat());
+  expect(outcome.refused).toMatch(/^RangeError: layer must be a whole number from 0 to 2/);
+});
+
+test('a head-motion seed changed while a clip is animated is for later clips: the clip under way keeps its own', async ({ page }) => {
+  await openDemo(page);
+  const same = await page.evaluate(async () => {
+    const engine = (globalThis as unknown as { talkingFace: { engine: any } }).talkingFace.engine;
+    const voice = Float32Array.from({ length: 16000 * 4 }, (_, i) => 0.3 * Math.sin(i / 8) * Math.sin(i / 3000));
+    engine.headMotionSeed = 0;
+    const whole = await engine.animate(voice, { chunkFrames: 30 });
+    const changed = await engine.animate(voice, { chunkFrames: 30, onProgress: () => { engine.headMotionSeed = null; } });
+    engine.headMotionSeed = 0;
+    return whole.pose.every((x: number, i: number) => x === changed.pose[i]);
+  });
+  expect(same).toBe(true);
+});

@@ -27,6 +27,9 @@ for (const [fault, pattern] of [['the runtime (.wasm) is not found', '**/ort/*/o
     await expect.poll(() => events(page), { timeout: 60_000 }).toContainEqual(expect.stringMatching(/^error:model:/));
     const [error] = (await events(page)).filter((e) => e.startsWith('error'));
     expect(error).toMatch(pattern.endsWith('.wasm') ? /ort-wasm/ : /gava\.safetensors/);
+    // The parts that did load (ONNX sessions, the decoder's workers) are freed: nothing of the failed load runs on.
+    const running = () => page.workers().map((w) => w.url()).filter((u) => /onnx-worker|decoder-worker/.test(u));
+    await expect.poll(running, { timeout: 10_000 }).toEqual([]);
     await context.unrouteAll({ behavior: 'ignoreErrors' });
     const spoke = await page.evaluate(() => (document.getElementById('left') as El).speak('/examples/sample.wav').then(() => 'played', (e: Error) => `failed: ${e.message}`));
     expect(spoke).toBe('played');

@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { checkedBackend, checkedChunk, checkedFrame, checkedSamples } from '../../../src/engine/checks';
+import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedWorkers } from '../../../src/engine/checks';
 
 describe('the engine\'s argument checks', () => {
   it('samples: a Float32Array of finite audio, else an error that names what is wrong', () => {
@@ -27,5 +27,13 @@ describe('the engine\'s argument checks', () => {
     expect(checkedBackend('webgpu')).toBe('webgpu');
     expect(() => checkedBackend('gpu')).toThrow(/'auto', 'cpu' or 'webgpu', not "gpu"/);
     expect(() => checkedBackend(undefined)).toThrow(RangeError);
+  });
+
+  it('decoder workers: 0 to 64 whole (NaN would decode nothing, Infinity start workers forever); layers counted from 0', () => {
+    for (const ok of [0, 1, 4, 64]) expect(checkedWorkers(ok)).toBe(ok);
+    for (const bad of [NaN, Infinity, -1, 2.5, 65, '4']) expect(() => checkedWorkers(bad)).toThrow(/cpuWorkers must be a whole number from 0 to 64/);
+    expect(checkedLayer(0, 3)).toBe(0);
+    expect(checkedLayer(2, 3)).toBe(2);
+    for (const bad of [3, -1, 1.5, NaN, '2']) expect(() => checkedLayer(bad, 3)).toThrow(/layer must be a whole number from 0 to 2 \(the decoder's layers count from 0\)/);
   });
 });
