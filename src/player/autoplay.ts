@@ -19,7 +19,8 @@ export interface GestureWait {
 /**
  * Once `resumed` (the context's resume()) settles or AUTOPLAY_WAIT_MS pass, a context still suspended is resumed at
  * the next gesture, while `current()` holds. Returns what removes the listeners (call it when the sound is no longer
- * wanted: stopped, disposed); they also go at the first gesture after the context runs or closes.
+ * wanted: stopped, disposed); they also go at the first gesture after the context runs or closes, or as soon as it
+ * runs by itself (an output slow to start, a Bluetooth device waking, was no autoplay block: onUnblocked then too).
  */
 export function resumeOnGesture(context: AudioContext, resumed: Promise<unknown>, current: () => boolean, wait: GestureWait = {}): () => void {
   let [forgotten, listening] = [false, false];
@@ -34,7 +35,15 @@ export function resumeOnGesture(context: AudioContext, resumed: Promise<unknown>
     forgotten = true;
     if (listening) for (const g of GESTURES) document.removeEventListener(g, resume, true);
     listening = false;
+    context.removeEventListener('statechange', ranByItself);
   };
+  const ranByItself = () => {
+    if (forgotten || context.state !== 'running') return;
+    const told = listening;
+    forget();
+    if (told && current()) wait.onUnblocked?.();
+  };
+  context.addEventListener('statechange', ranByItself);
   void Promise.race([resumed, new Promise((r) => setTimeout(r, AUTOPLAY_WAIT_MS))]).then(() => {
     if (forgotten || !current() || context.state !== 'suspended') return;
     listening = true;

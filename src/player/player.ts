@@ -7,6 +7,7 @@ import type { Animation, Frames } from '../engine/frames';
 import type { BlendshapeFrames } from '../avatar/weights';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
 import { resumeOnGesture } from './autoplay';
+import { heardTime } from './stream-timeline';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -52,6 +53,9 @@ interface Playing {
   finish: () => void;
 }
 
+/** What a disposed Player's play() and tap() say. */
+const DISPOSED = 'the face it played on is gone (its element removed, or its avatar changed)';
+
 export class Player {
   /** Start again from the first frame when the end is reached. */
   loop = false;
@@ -59,6 +63,7 @@ export class Player {
   private buffer: AudioBuffer | null = null;
   private shape: ((frame: number, unposed: Float32Array) => Float32Array) | null = null;
   private context: AudioContext | null = null;
+  private disposed = false;
   private tapNode: MediaStreamAudioDestinationNode | null = null; // where the sound also goes while tapped
   private gain: GainNode | null = null; // the volume, between the sound and the speakers (not the tap)
   private level = 1;
@@ -174,6 +179,7 @@ export class Player {
   play(from?: number, once = false): Promise<void> {
     const a = this.animation;
     if (!a || !this.buffer) return Promise.resolve();
+    if (this.disposed) return Promise.reject(new Error(DISPOSED));
     this.stop();
     const start = from ?? (this.currentFrame >= a.frames - 1 ? 0 : this.currentFrame);
     this.context ??= new AudioContext();
@@ -204,7 +210,9 @@ export class Player {
       let last = -1;
       const tick = () => {
         if (this.playing !== playing || this.animation !== a) return;
-        const f = playing.fromFrame + Math.floor((context.currentTime - playing.startedAt) * a.fps);
+        // What is heard now; while recorded, what goes into the recording (the tap takes the sound as it is rendered).
+        const now = this.tapNode ? context.currentTime : heardTime(context);
+        const f = playing.fromFrame + Math.floor((now - playing.startedAt) * a.fps);
         if (f !== last && f >= playing.fromFrame && f < a.frames) {
           last = f;
           this.show(f);
@@ -271,6 +279,7 @@ export class Player {
 
   /** The sound of what plays from now on as a stream too (a recording of the take: player/record-video.ts), until untap(). */
   tap(): MediaStream {
+    if (this.disposed) throw new Error(DISPOSED);
     this.context ??= new AudioContext();
     this.tapNode ??= this.context.createMediaStreamDestination();
     return this.tapNode.stream;
@@ -278,6 +287,7 @@ export class Player {
 
   untap(): void {
     this.tapNode?.disconnect();
+    for (const t of this.tapNode?.stream.getTracks() ?? []) t.stop(); // (the recording's track is not left live)
     this.tapNode = null;
   }
 
@@ -301,6 +311,7 @@ export class Player {
 
   /** Stop and release the audio output. */
   dispose(): void {
+    this.disposed = true; // (a recording waiting to start must not make a new context for it: play and tap refuse)
     this.stop();
     // Deliberate: closing an AudioContext fails only if it is already closed, which is the goal.
     void this.context?.close().catch(() => undefined); // fails only when already closed: the goal

@@ -46,7 +46,8 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
   view.recording = true; // drawn even where scrolled out of sight (else the video has no picture)
   try {
     player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
-    await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    // (a hidden tab draws no frames: the signal still cancels this wait)
+    await new Promise((r) => (requestAnimationFrame(() => requestAnimationFrame(r)), signal.addEventListener('abort', r, { once: true })));
     signal.throwIfAborted();
     video = canvas.captureStream(fps);
     recorder = new MediaRecorder(new MediaStream([...video.getVideoTracks(), ...player.tap().getAudioTracks()]),

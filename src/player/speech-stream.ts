@@ -155,6 +155,7 @@ export class SpeechStream {
     try {
       media.follower = await followMedia(media.stream, (piece) => this.accept(piece), () => this.end());
     } catch (e) {
+      if (this.closed || !this.host.current()) return; // stopped, or replaced, while the capture started: no failure of the work now
       return this.lost('audio', `the MediaStream's sound could not be followed: ${(e as Error).message}`);
     }
     if (this.closed || this.ended) void media.follower.stop(); // ended or stopped while the capture started

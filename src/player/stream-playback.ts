@@ -8,7 +8,7 @@
  */
 import type { Frames } from '../engine/frames';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
-import { SCHEDULE_MARGIN, StreamTimeline } from './stream-timeline';
+import { heardTime, SCHEDULE_MARGIN, StreamTimeline } from './stream-timeline';
 
 /** A pause in the sound longer than this (s) brings the face back to rest until the sound goes on. */
 export const REST_AFTER_SECONDS = 0.25;
@@ -105,8 +105,11 @@ export class StreamPlayback {
     const follows = this.timeline.follows(now);
     this.arrivals.push({ end: this.timeline.samples + this.waiting.reduce((n, w) => n + w.length, 0) + samples.length, time: now });
     if (this.needed > this.delay) { // and this piece starts a new span
-      this.delay = Math.min(MAX_DELAY, this.needed);
-      this.options.onDelay?.(this.delay);
+      const grown = Math.max(this.delay, Math.min(MAX_DELAY, this.needed)); // (a page's longer delay is never cut)
+      if (grown !== this.delay) {
+        this.delay = grown;
+        this.options.onDelay?.(grown);
+      }
     } else if (follows !== null && this.waiting.length === 0) return this.schedule(samples, follows);
     this.needed = 0;
     if (this.waiting.length === 0) this.waitingSince = now;
@@ -119,6 +122,7 @@ export class StreamPlayback {
     if (this.over || frames.count === 0) return;
     this.chunks.push({ first, frames });
     this.computed = first + frames.count;
+    this.forgetPast(); // (as draw() does: a hidden tab draws nothing, and a call may last hours)
     const late = this.lateness(first, frames.count);
     if (late > LATE_TOLERANCE) this.needed = Math.max(this.needed, this.spanDelay + late + GROW_MARGIN);
     this.release();
@@ -223,7 +227,7 @@ export class StreamPlayback {
     if (this.over) return;
     this.release();
     const now = this.context.currentTime;
-    const at = this.timeline.at(now);
+    const at = this.timeline.at(heardTime(this.context)); // what is heard now (the sound scheduled ahead of it)
     if (at && this.computed > 0) {
       const f = Math.floor((at.sample / this.rate) * this.fps);
       const late = f >= this.computed;
@@ -236,13 +240,24 @@ export class StreamPlayback {
       }
     }
     if (this.ending(now)) return;
-    this.timeline.forget(now - FORGET_AFTER);
     this.tick = requestAnimationFrame(this.draw);
   };
 
+  /** Forget the frames before `f` that showing it no longer needs, and the spans of sound long over. */
+  private forget(f: number): void {
+    while (this.chunks.length > 1 && this.chunks[1].first <= f - LIVE_REST_FRAMES) this.chunks.shift();
+    this.timeline.forget(this.context.currentTime - FORGET_AFTER);
+  }
+
+  /** forget() up to the frame heard now. */
+  private forgetPast(): void {
+    const at = this.timeline.at(heardTime(this.context));
+    if (at) this.forget(Math.floor((at.sample / this.rate) * this.fps));
+  }
+
   /** Show frame `f`; `sounding` false (the stream paused): the face rests. `report`: tell onFrame. */
   private show(f: number, sounding: boolean, report = true): void {
-    while (this.chunks.length > 1 && this.chunks[1].first <= f - LIVE_REST_FRAMES) this.chunks.shift();
+    this.forget(f);
     let k = this.chunks.length - 1;
     while (k > 0 && this.chunks[k].first > f) k--;
     const { first, frames } = this.chunks[k];

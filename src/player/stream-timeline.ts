@@ -11,6 +11,17 @@ export interface TimelineSpan {
   end: number;
 }
 
+/**
+ * The clock time of the sound being heard now: `currentTime` is that of the next block the context renders, which
+ * reaches the ear its base latency and the output's latency later (a few tens of ms wired, 0.15-0.3 s on Bluetooth
+ * headphones): frames chosen by it would move the mouth before its sound. (outputLatency is not known everywhere,
+ * Safari: 0 there.)
+ */
+export function heardTime(context: BaseAudioContext): number {
+  const c = context as AudioContext;
+  return c.currentTime - (c.baseLatency || 0) - (c.outputLatency || 0);
+}
+
 /** How close to now a piece may be scheduled and still play whole (s). */
 export const SCHEDULE_MARGIN = 0.02;
 

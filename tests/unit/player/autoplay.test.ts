@@ -100,4 +100,17 @@ describe('resumeOnGesture', () => {
     expect(onUnblocked).toHaveBeenCalledTimes(1);
     expect(doc.listening).toBe(0);
   });
+
+  it('a context that runs by itself after the wait (an output slow to start) was no block: unblocked, listeners gone', async () => {
+    const context = held();
+    const calls: string[] = [];
+    resumeOnGesture(context as unknown as AudioContext, context.resume(), () => true,
+      { onBlocked: () => calls.push('blocked'), onUnblocked: () => calls.push('unblocked') });
+    await vi.advanceTimersByTimeAsync(AUTOPLAY_WAIT_MS + 10);
+    expect(calls).toEqual(['blocked']);
+    expect(doc.listening).toBeGreaterThan(0);
+    context.allow(); // it starts, no gesture made
+    expect(calls).toEqual(['blocked', 'unblocked']);
+    expect(doc.listening).toBe(0);
+  });
 });

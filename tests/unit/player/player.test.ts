@@ -36,13 +36,14 @@ function animation(frames: number): Animation {
 }
 
 /** An AudioContext whose clock the test moves, and requestAnimationFrame driven by the test. */
-class FakeContext {
+class FakeContext extends EventTarget {
   static last: FakeContext;
   currentTime = 0;
   destination = {};
   sources: { onended: (() => void) | null; started: number[]; stopped: boolean; to: unknown[] }[] = [];
   gains: { gain: { value: number }; to: unknown[] }[] = [];
   constructor() {
+    super();
     FakeContext.last = this;
   }
   resume() { return Promise.resolve(); }
@@ -169,6 +170,40 @@ describe('Player', () => {
     await again;
     expect(ctx.sources[1].stopped).toBe(true);
     expect(ended).toBe(1);
+  });
+
+  it('shows the frame of the sound being heard: the clock less the output\'s latency (Bluetooth headphones: 0.2 s)', () => {
+    const { view } = fakeView();
+    const seen: number[] = [];
+    const p = new Player(view, 1, { onFrame: (f) => seen.push(f) });
+    p.load(animation(20), {} as AudioBuffer);
+    void p.play();
+    const ctx = FakeContext.last as FakeContext & { baseLatency: number; outputLatency: number };
+    [ctx.baseLatency, ctx.outputLatency] = [0.01, 0.2];
+    ctx.currentTime = 0.05 + 0.75; // rendered 0.75 s in, heard 0.54 s in: frame 5, not 7
+    tick();
+    expect(seen[seen.length - 1]).toBe(5);
+    // Recorded (the sound tapped as it is rendered, into the video): the frame of what goes into the recording.
+    const track = { stopped: false, stop() { this.stopped = true; } };
+    Object.assign(ctx, { createMediaStreamDestination: () => ({ stream: { getTracks: () => [track] }, disconnect: () => undefined }) });
+    p.tap();
+    ctx.currentTime = 0.05 + 0.85;
+    tick();
+    expect(seen[seen.length - 1]).toBe(8);
+    p.untap();
+    expect(track.stopped, 'the recording\'s track is stopped with it').toBe(true);
+    p.stop();
+  });
+
+  it('once disposed, refuses to play or be recorded (no new audio context for a face that is gone)', async () => {
+    const { view } = fakeView();
+    const p = new Player(view, 1);
+    p.load(animation(4), {} as AudioBuffer);
+    p.dispose();
+    const made = FakeContext.last;
+    await expect(p.play()).rejects.toThrow(/the face it played on is gone/);
+    expect(() => p.tap()).toThrow(/the face it played on is gone/);
+    expect(FakeContext.last).toBe(made);
   });
 
   it('loops when asked', async () => {

@@ -55,6 +55,18 @@ describe('StreamPlayback', () => {
     expect(player.isPlaying).toBe(false);
   });
 
+  it('shows the frame of the sound being heard: the clock less the output\'s latency', () => {
+    const { player, shown } = stage();
+    const p = new StreamPlayback(player, RATE, FPS, 0.3, {});
+    p.write(new Float32Array(1000));
+    p.frames(0, frames(0, 10));
+    const ctx = FakeContext.last as unknown as { baseLatency: number; outputLatency: number };
+    [ctx.baseLatency, ctx.outputLatency] = [0.01, 0.2];
+    drawAt(0.95); // rendering 0.65 s into the span, heard 0.44 s in: frame 4, not 6
+    expect(shown.at(-1)).toBe(4);
+    p.stop();
+  });
+
   it('does not start the sound before the frame of its first sample has come', () => {
     const { player } = stage();
     const p = new StreamPlayback(player, RATE, FPS, 0.1);
@@ -90,6 +102,33 @@ describe('StreamPlayback', () => {
     p.write(new Float32Array(100));
     expect([p.delay, p.pauses]).toEqual([expect.closeTo(0.45 + GROW_MARGIN, 9), 1]);
     expect(FakeContext.last.sources.at(-1)!.at).toBeCloseTo(0.85 + 0.45 + GROW_MARGIN + 0.1, 9); // right after the piece before
+  });
+
+  it('keeps only the frames it may still show while nothing is drawn (a hidden tab), however long the stream', () => {
+    const { player } = stage();
+    const p = new StreamPlayback(player, RATE, FPS, 0.3, {});
+    for (let second = 0; second < 60; second++) { // a minute of speech, one piece and its frames a second, no frame drawn
+      FakeContext.last.currentTime = second;
+      p.write(new Float32Array(RATE));
+      p.frames(second * FPS, frames(second * FPS, FPS));
+    }
+    const kept = (p as unknown as { chunks: unknown[] }).chunks.length;
+    expect(kept).toBeLessThanOrEqual(3);
+    p.stop();
+  });
+
+  it('never cuts a delay the page chose longer than the growth\'s ceiling (MAX_DELAY)', () => {
+    const { player } = stage();
+    const told: number[] = [];
+    const p = new StreamPlayback(player, RATE, FPS, 5, { onDelay: (d) => told.push(d) });
+    p.write(new Float32Array(500));
+    p.frames(0, frames(0, 1)); // the sound starts at 5 s
+    drawAt(5.35);
+    p.frames(1, frames(1, 4)); // frames 1-4, due from 5.1 s: late
+    p.write(new Float32Array(100)); // a new span: the delay would grow here
+    expect(p.delay).toBe(5);
+    expect(told).toEqual([]);
+    p.stop();
   });
 
   it('does not grow the delay for frames that waited for the sound after a pause (the next sentence), only for slow ones', () => {
