@@ -16,7 +16,7 @@ export async function listenLive(host: WorkHost, lost: (stage: TalkingFaceErrorD
   if (!engine || !host.current()) return null; // stopped (or removed) while the model loaded: the microphone stays closed
   const shown = await host.settled(); // an avatar may still be loading
   if (!host.current()) return null;
-  if (!shown) throw host.fail('avatar', NO_FACE); // not in the page, or no avatar: the microphone is not opened for nothing
+  if (!shown) throw host.fail('avatar', host.faceError() ?? NO_FACE); // not in the page, or no avatar: the microphone is not opened for nothing
   let media: MediaStream;
   try {
     media = await openMicrophone(deviceId);

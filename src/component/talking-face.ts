@@ -91,7 +91,7 @@ export class TalkingFaceElement extends ElementBase {
 
   connectedCallback(): void {
     // Moved within the page (disconnectedCallback kept everything): it goes on, unless changed while out of it.
-    if (this.stage.view && this.engine) return this.refresh();
+    if (this.connected && (this.stage.view || this.engine || this.loading)) return this.refresh();
     [this.connected, this.retrying, this.made] = [true, false, loadKey(this, DEFAULT_MODEL)]; // this call shows the face once loaded
     void this.load().then(() => this.afterLoad(), () => undefined); // deliberate: load() has reported the failure (status line, `error` event)
   }
@@ -174,13 +174,14 @@ export class TalkingFaceElement extends ElementBase {
 
   /** What work of generation `gen` (stopped by `signal`) is lent: the model, the player, the status line, the events. */
   private host(gen: number, signal: AbortSignal): WorkHost {
-    return { signal, element: this, engine: unlessAborted(this.load(), signal), player: () => this.stage.player, settled: () => this.stage.settled(),
+    return { signal, element: this, engine: unlessAborted(this.load(), signal), player: () => this.stage.player, settled: () => this.stage.settled(), faceError: () => this.stage.error,
       current: () => gen === this.generation, status: (text) => this.status.set(text), fail: (stage, message) => this.fail(stage, message, gen),
       playing: (text) => this.status.set((this.playingStatus = text)), dispatch: (event) => this.dispatchEvent(event), halt: () => this.halt(false) };
   }
 
   /** Stop what this element does and claim the next generation for new work, which `signal` cancels. */
   private begin(): { gen: number; signal: AbortSignal } {
+    if (this.connected && !this.isConnected) throw this.fail('avatar', NO_FACE); // removed: not loaded again for nothing
     this.halt(false);
     this.work = new AbortController();
     return { gen: this.generation, signal: this.work.signal };
@@ -208,9 +209,7 @@ export class TalkingFaceElement extends ElementBase {
   }
 
   /** Stop playback and the microphone; the face (or avatar) goes back to rest. */
-  stop(): void {
-    this.halt(true);
-  }
+  stop(): void { this.halt(true); }
 
   /** Load again what the attributes changed (loadKey: nothing if they mean the same). Another backend takes its shared
    * engine and keeps the view; `src` autoplays again for another model or template, else only if it had not yet. */

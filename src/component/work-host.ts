@@ -15,6 +15,8 @@ export interface WorkHost {
   player(): Player | null;
   /** The player once the view being made is there (an avatar still loading is waited for); null where it failed. */
   settled(): Promise<Player | null>;
+  /** Why the face could not be made (its avatar failed), or null. */
+  faceError(): string | null;
   /** Whether this work is still the element's (not stopped, not replaced). */
   current(): boolean;
   /** Aborted when the work is stopped or replaced. */

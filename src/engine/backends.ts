@@ -174,8 +174,8 @@ export class DecoderBackends {
     const support = await detectWebGPU();
     if (overtaken()) return;
     if (!support.adapter) throw new ModelLoadError(`WebGPU is not available: ${support.description}`);
-    const device = await requestSharedDevice();
-    if (overtaken()) return;
+    const device = await requestSharedDevice().catch((e: unknown) => (overtaken() ? null : Promise.reject(e)));
+    if (!device || overtaken()) return;
     const decoder = new GpuDecoder(device, this.cpu.weights, this.adjacency, this.m, this.gpuFrames);
     this.watch(decoder);
     this.gpu = decoder;

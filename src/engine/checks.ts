@@ -54,3 +54,9 @@ export function checkedLayer(layer: unknown, layers: number): number {
   }
   return layer;
 }
+
+/** The head motion's seed: an integer, or null (the pose head's mean pose alone). */
+export function checkedSeed(seed: unknown): number | null {
+  if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
+  return seed as number | null;
+}

@@ -27,7 +27,7 @@ import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
 import { levels, SILENT_PEAK } from '../audio/decode';
-import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedWorkers } from './checks';
+import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedSeed, checkedWorkers } from './checks';
 import { ortThreads } from '../encoders/ort-worker-client';
 import { allOrFree } from '../model/all-or-free';
 
@@ -58,6 +58,8 @@ export class TalkingFaceEngine {
   static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
     if (options.backend !== undefined) checkedBackend(options.backend);
     if (options.cpuWorkers !== undefined) checkedWorkers(options.cpuWorkers);
+    if (options.headMotionSeed !== undefined) checkedSeed(options.headMotionSeed); // (before anything is loaded for nothing)
+    if (options.headMotionScale !== undefined) checkedScale(options.headMotionScale);
     // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
@@ -144,8 +146,7 @@ export class TalkingFaceEngine {
   }
 
   set headMotionSeed(seed: number | null) {
-    if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
-    this.pipeline.headSeed = seed;
+    this.pipeline.headSeed = checkedSeed(seed);
   }
 
   /** How far the head's own motion turns the head in new animations and streams (1: as fitted). */

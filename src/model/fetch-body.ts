@@ -29,6 +29,7 @@ export interface FetchBodyOptions {
 
 /** The response to `url` and its whole body; StalledError once nothing has arrived for `stallSeconds`; fetch's own errors as they are. */
 export async function fetchBody(url: string | URL, options: FetchBodyOptions = {}): Promise<FetchedBody> {
+  options.signal?.throwIfAborted();
   const fetchFn = options.fetch ?? fetch.bind(globalThis);
   const seconds = options.stallSeconds ?? STALL_SECONDS;
   const abort = new AbortController();
@@ -41,7 +42,6 @@ export async function fetchBody(url: string | URL, options: FetchBodyOptions = {
   const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(said)), { once: true }));
   stalled.catch(() => undefined); // deliberate: read in the races below, or never needed once the body is in
   const cancel = (): void => abort.abort(); // (the races then end, and the catch gives the caller's reason)
-  options.signal?.throwIfAborted();
   options.signal?.addEventListener('abort', cancel, { once: true });
   try {
     // A fetch that ignores the signal (a page's own fetch function) still cannot hang: the race ends it.

@@ -192,7 +192,7 @@ export class Player {
       this.output(source);
       const startedAt = context.currentTime + 0.05;
       const playing: Playing = { source, startedAt, fromFrame: start, finish: resolve };
-      source.onended = () => {
+      const ended = () => {
         if (this.playing !== playing) return;
         this.playing = null;
         if (this.loop && !once) {
@@ -204,6 +204,12 @@ export class Player {
         this.view.setSpeaking?.(false); // after speech, back to the face at rest
         resolve();
         this.options.onEnded?.();
+      };
+      // Its sound is rendered; it is heard its latency later: the last frames are shown until then (not while recorded).
+      source.onended = () => {
+        const lag = this.tapNode ? 0 : context.currentTime - heardTime(context);
+        if (lag > 0) setTimeout(ended, 1000 * lag);
+        else ended();
       };
       source.start(startedAt, start / a.fps);
       this.playing = playing;

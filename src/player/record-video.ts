@@ -47,7 +47,11 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
   try {
     player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
     // (a hidden tab draws no frames: the signal still cancels this wait)
-    await new Promise((r) => (requestAnimationFrame(() => requestAnimationFrame(r)), signal.addEventListener('abort', r, { once: true })));
+    await new Promise<void>((r) => {
+      const go = (): void => (signal.removeEventListener('abort', go), r());
+      requestAnimationFrame(() => requestAnimationFrame(go));
+      signal.addEventListener('abort', go, { once: true });
+    });
     signal.throwIfAborted();
     video = canvas.captureStream(fps);
     recorder = new MediaRecorder(new MediaStream([...video.getVideoTracks(), ...player.tap().getAudioTracks()]),

@@ -145,7 +145,7 @@ export class StreamPlayback {
       if (came <= due) ready = Math.min(ready, due); // (else its sound had begun before what it reads came: no delay helps)
     }
     while (this.arrivals.length > 1 && this.arrivals[1].end < Math.round((first / this.fps) * this.rate)) this.arrivals.shift();
-    return now - ready; // (-Infinity where none is placed yet: not late)
+    return heardTime(this.context) - ready; // (late once heard without it; -Infinity where none is placed yet: not late)
   }
 
   /** No more pieces, and every frame of them has come: once the last has played, the playback is over. */
@@ -194,11 +194,11 @@ export class StreamPlayback {
    */
   private endLater(): void {
     clearTimeout(this.endTimer);
-    const wait = Math.max(0, this.timeline.endTime - this.context.currentTime);
-    this.endTimer = setTimeout(() => this.over || this.ending(this.context.currentTime) || this.endLater(), 1000 * (wait + SCHEDULE_MARGIN));
+    const wait = Math.max(0, this.timeline.endTime - heardTime(this.context));
+    this.endTimer = setTimeout(() => this.over || this.ending(heardTime(this.context)) || this.endLater(), 1000 * (wait + SCHEDULE_MARGIN));
   }
 
-  /** Over once ended, nothing waits, the sound has played and the last frame was shown (or none can be): true then. */
+  /** Over once ended, nothing waits, the sound has been heard (`now`: heardTime) and the last frame was shown (or none can be): true then. */
   private ending(now: number): boolean {
     if (!this.ended || this.waiting.length > 0 || now < this.timeline.endTime) return false;
     if (this.computed > 0) this.show(this.computed - 1, false, this.computed - 1 !== this.shown); // over: the face back to rest
@@ -226,8 +226,8 @@ export class StreamPlayback {
     this.tick = 0;
     if (this.over) return;
     this.release();
-    const now = this.context.currentTime;
-    const at = this.timeline.at(heardTime(this.context)); // what is heard now (the sound scheduled ahead of it)
+    const now = heardTime(this.context); // what is heard now (the sound is rendered ahead of it)
+    const at = this.timeline.at(now);
     if (at && this.computed > 0) {
       const f = Math.floor((at.sample / this.rate) * this.fps);
       const late = f >= this.computed;
@@ -252,7 +252,7 @@ export class StreamPlayback {
   /** forget() up to the frame heard now. */
   private forgetPast(): void {
     const at = this.timeline.at(heardTime(this.context));
-    if (at) this.forget(Math.floor((at.sample / this.rate) * this.fps));
+    if (at) this.forget(Math.min(Math.floor((at.sample / this.rate) * this.fps), this.computed - 1));
   }
 
   /** Show frame `f`; `sounding` false (the stream paused): the face rests. `report`: tell onFrame. */

@@ -195,6 +195,27 @@ describe('Player', () => {
     p.stop();
   });
 
+  it('ends once its last sound is heard, not when it is rendered: the last frames are shown until then', async () => {
+    vi.useFakeTimers({ toFake: ['setTimeout', 'clearTimeout'] }); // (the animation frames stay the test's)
+    const { view } = fakeView();
+    const seen: number[] = [];
+    let ended = 0;
+    const p = new Player(view, 1, { onFrame: (f) => seen.push(f), onEnded: () => ended++ });
+    p.load(animation(20), {} as AudioBuffer);
+    const done = p.play();
+    const ctx = FakeContext.last as FakeContext & { baseLatency: number; outputLatency: number };
+    [ctx.baseLatency, ctx.outputLatency] = [0, 0.2];
+    ctx.currentTime = 0.05 + 2; // all 2 s rendered, 1.8 s heard
+    ctx.sources[0].onended!();
+    tick();
+    expect([seen.at(-1), ended, p.isPlaying]).toEqual([18, 0, true]);
+    ctx.currentTime += 0.2;
+    await vi.advanceTimersByTimeAsync(200);
+    await done;
+    expect([seen.at(-1), ended, p.isPlaying]).toEqual([19, 1, false]);
+    vi.useRealTimers();
+  });
+
   it('once disposed, refuses to play or be recorded (no new audio context for a face that is gone)', async () => {
     const { view } = fakeView();
     const p = new Player(view, 1);

@@ -104,6 +104,21 @@ describe('StreamPlayback', () => {
     expect(FakeContext.last.sources.at(-1)!.at).toBeCloseTo(0.85 + 0.45 + GROW_MARGIN + 0.1, 9); // right after the piece before
   });
 
+  it('is over once its last sound is heard, not when it is rendered', async () => {
+    const { player } = stage();
+    const p = new StreamPlayback(player, RATE, FPS, 0.3, {});
+    p.write(new Float32Array(500)); // plays 0.3 .. 0.8 on the rendering clock
+    p.frames(0, frames(0, 5));
+    p.end();
+    const ctx = FakeContext.last as unknown as { baseLatency: number; outputLatency: number };
+    [ctx.baseLatency, ctx.outputLatency] = [0, 0.2];
+    drawAt(0.85); // rendered, not yet heard (0.65)
+    expect(p.playedOut).toBe(false);
+    drawAt(1.01);
+    await p.done;
+    expect(p.playedOut).toBe(true);
+  });
+
   it('keeps only the frames it may still show while nothing is drawn (a hidden tab), however long the stream', () => {
     const { player } = stage();
     const p = new StreamPlayback(player, RATE, FPS, 0.3, {});
