@@ -132,46 +132,30 @@ test('live frame events count the frames skipped to stay live, and a device that
   expect(Math.max(...s.slice(before, before + 3)) - s[before - 1], `frames skipped over the held 1.5 s: ${s}`).toBeGreaterThanOrEqual(20);
 });
 
-test('live set again after the model failed to load loads it again and listens', async ({ page, guard }) => {
-  test.setTimeout(120_000);
-  guard.allowConsoleError(/ERR_INTERNET_DISCONNECTED/);
-  let asked = 0; // the first request for the model fails, as offline; the next one is served
-  await page.route('**/models/manifest.json?flaky', (route) => (asked++ === 0 ? route.abort('internetdisconnected') : route.continue()));
-  const failed = await page.evaluate(() => new Promise<string>((resolve) => {
-    const el = document.createElement('talking-face');
-    Object.assign(el, { id: 'flaky' });
-    el.setAttribute('model', '/models/manifest.json?flaky');
-    el.setAttribute('live', '');
-    el.addEventListener('error', (e) => resolve((e as CustomEvent).detail.stage), { once: true });
-    document.body.append(el);
-  }));
-  expect(failed).toBe('model');
-  await page.evaluate(() => {
-    const el = document.getElementById('flaky')!;
-    el.removeAttribute('live');
-    el.setAttribute('live', '');
+// A page's Retry after the model failed to load: setting `live` again, or reading `ready`.
+for (const retry of ['live set again', '`ready` read'] as const) {
+  test(`${retry} after the model failed to load loads it again, and a live element then listens`, async ({ page, guard }) => {
+    test.setTimeout(120_000);
+    guard.allowConsoleError(/ERR_INTERNET_DISCONNECTED/);
+    let asked = 0; // the first request for the model fails, as offline; the next one is served
+    await page.route('**/models/manifest.json?flaky', (route) => (asked++ === 0 ? route.abort('internetdisconnected') : route.continue()));
+    const failed = await page.evaluate(() => new Promise<string>((resolve) => {
+      const el = document.createElement('talking-face');
+      Object.assign(el, { id: 'flaky' });
+      el.setAttribute('model', '/models/manifest.json?flaky');
+      el.setAttribute('live', '');
+      el.addEventListener('error', (e) => resolve((e as CustomEvent).detail.stage), { once: true });
+      document.body.append(el);
+    }));
+    expect(failed).toBe('model');
+    await page.evaluate(async (how) => {
+      const el = document.getElementById('flaky') as HTMLElement & { ready: Promise<unknown> };
+      if (how === '`ready` read') return void (await el.ready);
+      el.removeAttribute('live');
+      el.setAttribute('live', '');
+    }, retry);
+    await expect.poll(() => page.evaluate(() => document.getElementById('flaky')!.shadowRoot!.querySelector('p.status')!.textContent!), { timeout: 60_000 }).toContain('Listening');
+    expect(asked).toBe(2);
+    await page.evaluate(() => (document.getElementById('flaky') as unknown as { stop(): void }).stop());
   });
-  await expect.poll(() => page.evaluate(() => document.getElementById('flaky')!.shadowRoot!.querySelector('p.status')!.textContent!), { timeout: 60_000 }).toContain('Listening');
-  expect(asked).toBe(2);
-  await page.evaluate(() => (document.getElementById('flaky') as unknown as { stop(): void }).stop());
-});
-
-test('`ready` read after the model failed to load loads it again, and a live element then listens', async ({ page, guard }) => {
-  test.setTimeout(120_000);
-  guard.allowConsoleError(/ERR_INTERNET_DISCONNECTED/);
-  let asked = 0; // the first request for the model fails, as offline; the next one is served
-  await page.route('**/models/manifest.json?flaky-ready', (route) => (asked++ === 0 ? route.abort('internetdisconnected') : route.continue()));
-  const failed = await page.evaluate(() => new Promise<string>((resolve) => {
-    const el = document.createElement('talking-face');
-    Object.assign(el, { id: 'flaky' });
-    el.setAttribute('model', '/models/manifest.json?flaky-ready');
-    el.setAttribute('live', '');
-    el.addEventListener('error', (e) => resolve((e as CustomEvent).detail.stage), { once: true });
-    document.body.append(el);
-  }));
-  expect(failed).toBe('model');
-  await page.evaluate(() => (document.getElementById('flaky') as unknown as { ready: Promise<unknown> }).ready); // a page's Retry
-  await expect.poll(() => page.evaluate(() => document.getElementById('flaky')!.shadowRoot!.querySelector('p.status')!.textContent!), { timeout: 60_000 }).toContain('Listening');
-  expect(asked).toBe(2);
-  await page.evaluate(() => (document.getElementById('flaky') as unknown as { stop(): void }).stop());
-});
+}

@@ -60,6 +60,16 @@ class FakeContext extends EventTarget {
     return s;
   }
 }
+/** A player of `frames` frames, playing: the frames it showed, its ended count, and play()'s promise. */
+function playing(frames: number) {
+  const { view } = fakeView();
+  const seen: number[] = [];
+  const ended = { count: 0 };
+  const p = new Player(view, 1, { onFrame: (f) => seen.push(f), onEnded: () => ended.count++ });
+  p.load(animation(frames), {} as AudioBuffer);
+  return { p, seen, ended, done: p.play() };
+}
+
 let frameCallbacks: (() => void)[] = [];
 const tick = () => {
   const cbs = frameCallbacks;
@@ -147,12 +157,7 @@ describe('Player', () => {
   });
 
   it('plays in sync with the audio clock, stops, and reports the natural end', async () => {
-    const { view } = fakeView();
-    const seen: number[] = [];
-    let ended = 0;
-    const p = new Player(view, 1, { onFrame: (f) => seen.push(f), onEnded: () => ended++ });
-    p.load(animation(20), {} as AudioBuffer);
-    const done = p.play();
+    const { p, seen, done, ended } = playing(20);
     const ctx = FakeContext.last;
     expect(p.isPlaying).toBe(true);
     ctx.currentTime = 0.05 + 0.75; // 0.75 s after the scheduled start: frame 7
@@ -160,7 +165,7 @@ describe('Player', () => {
     expect(seen[seen.length - 1]).toBe(7);
     ctx.sources[0].onended!();
     await done;
-    expect(ended).toBe(1);
+    expect(ended.count).toBe(1);
     expect(seen[seen.length - 1]).toBe(19); // the last frame is left on screen
     expect(p.isPlaying).toBe(false);
     // Play again from frame 5; stop() resolves it without an end.
@@ -169,15 +174,11 @@ describe('Player', () => {
     p.stop();
     await again;
     expect(ctx.sources[1].stopped).toBe(true);
-    expect(ended).toBe(1);
+    expect(ended.count).toBe(1);
   });
 
   it('shows the frame of the sound being heard: the clock less the output\'s latency (Bluetooth headphones: 0.2 s)', () => {
-    const { view } = fakeView();
-    const seen: number[] = [];
-    const p = new Player(view, 1, { onFrame: (f) => seen.push(f) });
-    p.load(animation(20), {} as AudioBuffer);
-    void p.play();
+    const { p, seen } = playing(20);
     const ctx = FakeContext.last as FakeContext & { baseLatency: number; outputLatency: number };
     [ctx.baseLatency, ctx.outputLatency] = [0.01, 0.2];
     ctx.currentTime = 0.05 + 0.75; // rendered 0.75 s in, heard 0.54 s in: frame 5, not 7
@@ -197,22 +198,17 @@ describe('Player', () => {
 
   it('ends once its last sound is heard, not when it is rendered: the last frames are shown until then', async () => {
     vi.useFakeTimers({ toFake: ['setTimeout', 'clearTimeout'] }); // (the animation frames stay the test's)
-    const { view } = fakeView();
-    const seen: number[] = [];
-    let ended = 0;
-    const p = new Player(view, 1, { onFrame: (f) => seen.push(f), onEnded: () => ended++ });
-    p.load(animation(20), {} as AudioBuffer);
-    const done = p.play();
+    const { p, seen, done, ended } = playing(20);
     const ctx = FakeContext.last as FakeContext & { baseLatency: number; outputLatency: number };
     [ctx.baseLatency, ctx.outputLatency] = [0, 0.2];
     ctx.currentTime = 0.05 + 2; // all 2 s rendered, 1.8 s heard
     ctx.sources[0].onended!();
     tick();
-    expect([seen.at(-1), ended, p.isPlaying]).toEqual([18, 0, true]);
+    expect([seen.at(-1), ended.count, p.isPlaying]).toEqual([18, 0, true]);
     ctx.currentTime += 0.2;
     await vi.advanceTimersByTimeAsync(200);
     await done;
-    expect([seen.at(-1), ended, p.isPlaying]).toEqual([19, 1, false]);
+    expect([seen.at(-1), ended.count, p.isPlaying]).toEqual([19, 1, false]);
     vi.useRealTimers();
   });
 
