@@ -6,6 +6,7 @@
 import type { TalkingFaceEngine, Animation, Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { placeFrames } from '../engine/frames';
+import { stopTracks } from '../audio/capture';
 
 export interface FinishedTake {
   animation: Animation;
@@ -34,7 +35,7 @@ export class Recording {
    */
   static async start(engine: TalkingFaceEngine, open: () => Promise<MediaStream>, onFrames: (frames: Frames) => void,
     tell: (text: string, isError: boolean) => void, signal?: AbortSignal): Promise<Recording> {
-    const media = await unlessAborted(open(), signal);
+    const media = await untilCancelled(open(), signal);
     engine.resetTimes();
     let recording: Recording | null = null;
     const pending: { first: number; frames: Frames }[] = [];
@@ -51,7 +52,7 @@ export class Recording {
       onError: (e) => warn(`Live animation stopped: ${e.message}`),
       onInterrupted: (e) => warn(`Recording, but ${e.message}. Stop recording keeps what was heard.`),
     }).catch((e: unknown) => {
-      letGo(media);
+      stopTracks(media);
       throw e;
     });
     if (signal?.aborted) {
@@ -125,10 +126,8 @@ export class Recording {
   }
 }
 
-const letGo = (media: MediaStream): void => media.getTracks().forEach((t) => t.stop());
-
 /** The microphone `opening` gives, or `signal`'s reason as soon as it aborts (a microphone given later is let go). */
-function unlessAborted(opening: Promise<MediaStream>, signal?: AbortSignal): Promise<MediaStream> {
+function untilCancelled(opening: Promise<MediaStream>, signal?: AbortSignal): Promise<MediaStream> {
   if (!signal) return opening;
   return new Promise((resolve, reject) => {
     const abort = (): void => reject(signal.reason);
@@ -136,7 +135,7 @@ function unlessAborted(opening: Promise<MediaStream>, signal?: AbortSignal): Pro
     else signal.addEventListener('abort', abort, { once: true });
     opening.then((media) => {
       signal.removeEventListener('abort', abort);
-      if (signal.aborted) letGo(media);
+      if (signal.aborted) stopTracks(media);
       else resolve(media);
     }, (e: unknown) => {
       signal.removeEventListener('abort', abort);

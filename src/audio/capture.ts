@@ -243,7 +243,7 @@ export class AudioCapture {
     this.node.port.onmessage = null;
     this.source.disconnect();
     this.node.disconnect();
-    if (releaseStream) for (const t of this.stream.getTracks()) t.stop();
+    if (releaseStream) stopTracks(this.stream);
     // Deliberate: closing can only fail on a context that is already closed, which is the goal.
     await this.context.close().catch(() => undefined); // fails only on a context already closed: the goal
   }
@@ -272,4 +272,9 @@ async function addCaptureModule(context: AudioContext): Promise<void> {
   } finally {
     URL.revokeObjectURL(url);
   }
+}
+
+/** Let a stream's devices go: every track stopped (the browser's recording indicator goes off for a microphone). */
+export function stopTracks(stream: MediaStream | null | undefined): void {
+  for (const t of stream?.getTracks() ?? []) t.stop();
 }

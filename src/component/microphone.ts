@@ -1,7 +1,7 @@
 /** <talking-face>'s startMicrophone(): the microphone opened and animated live, its frames shown as they come. */
 import type { Frames } from '../engine/frames';
 import type { LiveSession } from '../engine/live';
-import { openMicrophone } from '../audio/capture';
+import { openMicrophone, stopTracks } from '../audio/capture';
 import { frameOptions } from './attributes';
 import { liveFrameDetail, type FrameDetail, type TalkingFaceErrorDetail } from './events';
 import { NO_FACE, type WorkHost } from './work-host';
@@ -24,7 +24,7 @@ export async function listenLive(host: WorkHost, lost: (stage: TalkingFaceErrorD
     if (!host.current()) return null; // stopped (or removed) while the browser asked: not a failure
     throw host.fail('microphone', (e as Error).message);
   }
-  const close = () => media.getTracks().forEach((t) => t.stop());
+  const close = () => stopTracks(media);
   if (!host.current()) return close(), null; // stopped while the browser asked
   let live: LiveSession | null = null;
   try {

@@ -8,6 +8,7 @@ import type { BlendshapeFrames } from '../avatar/weights';
 import { LIVE_REST_FRAMES, SPEECH_PROBABILITY } from '../encoders/voice-activity';
 import { resumeOnGesture } from './autoplay';
 import { heardTime } from './stream-timeline';
+import { stopTracks } from '../audio/capture';
 
 /** What a Player draws on: the template's face (render/face-view.ts) or a glTF avatar (avatar/avatar-view.ts). */
 export interface PlayerView {
@@ -293,7 +294,7 @@ export class Player {
 
   untap(): void {
     this.tapNode?.disconnect();
-    for (const t of this.tapNode?.stream.getTracks() ?? []) t.stop(); // (the recording's track is not left live)
+    stopTracks(this.tapNode?.stream); // (the recording's track is not left live)
     this.tapNode = null;
   }
 

@@ -8,6 +8,7 @@
  * in the browser and saved by the visitor.
  */
 import type { Player } from './player';
+import { stopTracks } from '../audio/capture';
 
 /** Containers and codecs tried in order (the first the browser records is used). */
 export const VIDEO_TYPES = ['video/webm;codecs=vp9,opus', 'video/webm;codecs=vp8,opus', 'video/webm', 'video/mp4'];
@@ -71,7 +72,7 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
     if (r && r.state !== 'inactive') await new Promise((done) => { r.onstop = done; r.stop(); }); // its last data comes first
     player.untap();
     view.recording = false;
-    for (const t of video?.getTracks() ?? []) t.stop();
+    stopTracks(video);
   }
   const file = new Blob(chunks, { type: type.split(';')[0] });
   if (file.size === 0) throw new Error('the browser recorded nothing (is the face drawn on this page?)');
