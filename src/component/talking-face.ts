@@ -39,8 +39,8 @@ export class TalkingFaceElement extends ElementBase {
   private hold: EngineHold | null = null; // on the shared engine (engines.ts): released when removed or switched
   private liveSession: LiveSession | null = null; // (not `live`: a framework would set it for the `live` attribute)
   private speech: SpeechStream | null = null; // the last speakStream()
-  private animation: Animation | null = null;
   private computeMs = 0;
+  private endings = 0; // takes that played to their end (`ended` sent): recordVideo() cancelled after one sends none again
   private audioSeconds = 0;
   private generation = 0; // bumps on stop() and on every new speak(): stale work drops its results
   private work: AbortController | null = null; // the speak() or startMicrophone() under way: stop() aborts it
@@ -60,6 +60,7 @@ export class TalkingFaceElement extends ElementBase {
       onEnded: () => {
         this.status.set(this.playingStatus.replace(/^Playing/, 'Played')); // the same notes, in the past: it is over
         this.dispatchEvent(new CustomEvent('ended'));
+        this.endings++;
       },
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
       onBlocked: () => this.status.set('Click or press a key to hear it: the browser plays sound only after a gesture.'),
@@ -74,8 +75,9 @@ export class TalkingFaceElement extends ElementBase {
   get backend(): Backend | null { return this.engine?.backend ?? null; }
   set backend(value: 'auto' | Backend | null) { reflect(this, 'backend', value); }
 
-  /** The last offline animation (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it. */
-  get currentAnimation(): Animation | null { return this.animation; }
+  /** The take shown (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it; null before one,
+   * and once the avatar, model or template changes (what it was made for is gone: recordVideo() has nothing to replay). */
+  get currentAnimation(): Animation | null { return this.stage.player?.take ?? null; }
 
   /** How loud the speech plays, 0 to 1 (default 1), as a media element's `volume`: the face keeps in sync at any volume. */
   get volume(): number { return this.stage.volume; }
@@ -141,7 +143,6 @@ export class TalkingFaceElement extends ElementBase {
     if (gen !== this.generation) return;
     if (!player) throw this.fail('avatar', this.stage.error ?? NO_FACE, gen);
     this.work = null; // animated: stop() from here stops the playback
-    this.animation = take.animation;
     player.load(take.animation, take.decoded.buffer);
     player.show(0);
     this.playingStatus = take.playing;
@@ -166,7 +167,7 @@ export class TalkingFaceElement extends ElementBase {
     const work = this.work;
     return (this.speech = new SpeechStream(checked, elementStreamHost(this.host(gen, signal), ({ animation, buffer }) => {
       if (this.work === work) this.work = null; // played out: stop() has nothing left to stop
-      [this.animation, this.computeMs, this.audioSeconds] = [animation, NaN, buffer.duration]; // (no compute time of its own)
+      [this.computeMs, this.audioSeconds] = [NaN, buffer.duration]; // (no compute time of its own)
       this.playingStatus = `Playing streamed speech (${buffer.duration.toFixed(1)} s).`; // (recordVideo() plays it again)
       this.stage.player?.load(animation, buffer); // for recordVideo()
     })));
@@ -201,11 +202,11 @@ export class TalkingFaceElement extends ElementBase {
 
   /** The last take replayed and recorded with its sound as a video (WebM or MP4) in real time; `signal` cancels. */
   async recordVideo(options: { signal?: AbortSignal; onProgress?: (seconds: number) => void } = {}): Promise<Blob> {
-    const { engine, animation } = this;
+    const { engine, currentAnimation: animation, endings } = this;
     if (this.speech?.open) throw this.fail('render', 'streamed speech is playing: record once it has played (its take is then recorded)');
     if (!engine || !animation) throw this.fail('render', 'there is no take to record: speak() one first');
     return this.stage.recordVideo(engine.fps, options.signal ?? new AbortController().signal, (f) => options.onProgress?.(f / engine.fps))
-      .catch((e: Error) => Promise.reject(options.signal?.aborted ? (this.rest(), e) : this.fail('render', `the video could not be made: ${e.message}`)));
+      .catch((e: Error) => Promise.reject(options.signal?.aborted ? (this.endings === endings && this.rest(), e) : this.fail('render', `the video could not be made: ${e.message}`)));
   }
 
   /** Stop playback and the microphone; the face (or avatar) goes back to rest. */
@@ -314,7 +315,7 @@ export class TalkingFaceElement extends ElementBase {
 
   /** A frame event for each frame shown while playing. */
   private playbackFrame(frame: number): void {
-    const a = this.animation;
+    const a = this.currentAnimation;
     if (!a || !this.engine || !this.stage.player?.isPlaying) return;
     this.dispatchEvent(new CustomEvent<FrameDetail>('frame', { detail: playbackFrameDetail(this.engine, a, frame, this.computeMs, this.audioSeconds) }));
   }

@@ -39,8 +39,15 @@ test('the element records its last take as a video with its sound; before a take
     const cancelled = f.recordVideo({ signal: stop.signal }).then(() => 'made', (e: Error) => e.name);
     setTimeout(() => stop.abort(), 500);
     const take = f.currentAnimation!;
+    const cancelledEarly = await cancelled;
+    const endedOnCancel = ended;
+    // Cancelled in its half-second tail, once the take has played to its end (and said so): `ended` is not sent again.
+    const late = new AbortController();
+    f.addEventListener('ended', () => late.abort(), { once: true });
+    ended = 0;
+    const lateCancel = await f.recordVideo({ signal: late.signal }).then(() => 'made', (e: Error) => e.name);
     return { type: blob.type, magic: [...data.subarray(0, 4)], seconds: sound.duration, take: take.frames / take.fps, peak, progress,
-      size: [video.videoWidth, video.videoHeight], canvas: [canvas.width, canvas.height], cancelled: await cancelled, endedOnCancel: ended, errors };
+      size: [video.videoWidth, video.videoHeight], canvas: [canvas.width, canvas.height], cancelled: cancelledEarly, endedOnCancel, lateCancel, endedOnLateCancel: ended, errors };
   });
   console.log(`element video: ${JSON.stringify(read)}`);
   expect(read.type).toMatch(/^video\/(webm|mp4)$/);
@@ -52,5 +59,24 @@ test('the element records its last take as a video with its sound; before a take
   expect(read.size).toEqual(read.canvas);
   expect(read.cancelled).toBe('AbortError');
   expect(read.endedOnCancel).toBe(1);
+  expect(read.lateCancel).toBe('AbortError');
+  expect(read.endedOnLateCancel).toBe(1);
   expect(read.errors).toEqual([]);
+});
+
+test('once the avatar changes, the element has no take: currentAnimation is null and recordVideo() says so', async ({ page }) => {
+  test.setTimeout(120_000);
+  await page.goto('/examples/embed.html');
+  const face = page.locator('#left');
+  await expect.poll(() => face.evaluate((el) => (el as FaceEl & { backend: string | null }).backend), { timeout: 60_000 }).toBe('cpu');
+  await face.evaluate((el) => (el as FaceEl).speak('/examples/sample.wav'));
+  expect(await face.evaluate((el) => (el as FaceEl).currentAnimation?.frames)).toBeGreaterThan(0);
+  const after = await face.evaluate(async (el) => {
+    const f = el as FaceEl;
+    const ready = new Promise((r) => f.addEventListener('ready', r, { once: true }));
+    f.setAttribute('avatar', '/examples/avatars/arkit-face.glb');
+    await ready;
+    return { take: f.currentAnimation, record: await f.recordVideo().then(() => 'made', (e: Error) => e.message) };
+  });
+  expect(after).toEqual({ take: null, record: 'there is no take to record: speak() one first' });
 });
