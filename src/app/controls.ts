@@ -73,13 +73,21 @@ export function showStatus(text: string, isError = false): void {
   ui.status.classList.toggle('error', isError);
 }
 
-let announced = '';
+/** The same news within this long is one change told twice: announced once. */
+const REPEAT_MS = 1000;
+let announced = { text: '', at: -Infinity };
 
-/** Tell screen readers of a change of state, once: the live region hears of ready, playing, recording, errors, never of progress. */
+/**
+ * Tell screen readers of a change of state, once: the live region hears of ready, playing, recording, errors, never of
+ * progress. The same news again later (a second export saved) is heard again: the region is emptied, then refilled.
+ */
 export function announce(text: string): void {
-  if (text === announced) return;
-  announced = text;
-  ui.announcer.textContent = text;
+  const at = performance.now();
+  const again = text === announced.text;
+  if (again && at - announced.at < REPEAT_MS) return;
+  announced = { text, at };
+  ui.announcer.textContent = again ? '' : text;
+  if (again) setTimeout(() => { if (announced.text === text) ui.announcer.textContent = text; }, 100); // (unless other news came)
 }
 
 /** A change of state: the status line says it and the live region announces it. */

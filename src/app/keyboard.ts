@@ -23,8 +23,9 @@ export function bindKeys(a: KeyActions): void {
   });
   ui.canvas.addEventListener('keydown', (ev) => {
     if (ev.ctrlKey || ev.metaKey || ev.altKey || cameraKey(ev, a.view())) return;
-    if (ev.key === ' ' && a.hasTake()) a.togglePlay();
-    else if ((ev.key === ',' || ev.key === '.') && a.hasTake()) a.step(ev.key === '.' ? 1 : -1);
+    if (ev.key === ' ' && a.hasTake()) {
+      if (!ev.repeat) a.togglePlay(); // held down: toggled once, not at every repeat
+    } else if ((ev.key === ',' || ev.key === '.') && a.hasTake()) a.step(ev.key === '.' ? 1 : -1);
     else return;
     ev.preventDefault();
   });

@@ -99,7 +99,7 @@ export class LipTimeline {
     const top = d.truthPhones ? labelRow : 2 * dpr;
     const headBand = d.head ? Math.round(0.38 * h) : 0;
     const bottom = h - labelRow - headBand;
-    const maxGap = Math.max(8, ...d.gap, ...(d.truthGap ? Array.from(d.truthGap) : []));
+    const maxGap = gapScale(d.gap, d.truthGap);
     const y = (mm: number) => bottom - (Math.max(0, mm) / maxGap) * (bottom - top);
     ctx.fillStyle = COLOURS.back;
     ctx.fillRect(0, 0, w, h);
@@ -175,6 +175,13 @@ export class LipTimeline {
       ctx.fillText(phone.toLowerCase(), x, y);
     }
   }
+}
+
+/** The top of the gap curves' scale, mm: the widest gap of either, at least 8 (a loop: spread as arguments, an hour's frames overflow the stack). */
+export function gapScale(gap: ArrayLike<number>, truthGap?: ArrayLike<number>): number {
+  let most = 8;
+  for (const gaps of truthGap ? [gap, truthGap] : [gap]) for (let i = 0; i < gaps.length; i++) most = Math.max(most, gaps[i]);
+  return most;
 }
 
 /**

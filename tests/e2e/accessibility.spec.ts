@@ -45,6 +45,19 @@ test('the demo: one live region, quiet while playing; Cancel hands its focus on;
   await page.keyboard.press('ArrowRight');
   await expect(page.locator('#scrub')).toHaveAttribute('aria-valuetext', /^0\.03 s of \d+\.\d\d s$/);
 
+  // The same news again later (the frames exported twice) is heard again: the region is emptied and filled anew.
+  const heard: number[] = [];
+  for (const round of [0, 1]) {
+    if (round) await page.waitForTimeout(1200); // (the same news within a second is one change told twice)
+    const before = (await liveChanges(page)).announce;
+    const saved = page.waitForEvent('download');
+    await page.locator('#export-raw').click();
+    await saved;
+    await expect(page.locator('#announce')).toHaveText(/^Saved .*: the raw frames\.$/);
+    heard.push((await liveChanges(page)).announce - before);
+  }
+  expect(heard[1], 'the second export is announced too').toBeGreaterThan(0);
+
   // A file take has no truth: choosing the error map says so to a screen reader too.
   await page.locator('#paint-select').selectOption('error');
   await expect(page.locator('#announce')).toHaveText(/The error map needs a sample clip/);

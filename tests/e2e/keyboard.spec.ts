@@ -88,7 +88,10 @@ test('open, play, pause, scrub, orbit, zoom, step, record, stop and export by ke
   await expect(page.locator('#scrub')).toHaveValue('3');
   await page.keyboard.press(',');
   await expect(page.locator('#scrub')).toHaveValue('2');
-  await page.keyboard.press('Space');
+  // Space held down plays once: its repeats do not toggle playback on and off.
+  await page.keyboard.down(' ');
+  for (let i = 0; i < 3; i++) await page.keyboard.down(' '); // (each a repeat)
+  await page.keyboard.up(' ');
   await expect(page.locator('#play-button')).toHaveText('Pause');
   await page.keyboard.press('Escape');
   await expect(page.locator('#play-button')).toHaveText('Play');

@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { labelsThatFit } from '../../../src/app/timeline';
+import { gapScale, labelsThatFit } from '../../../src/app/timeline';
 
 const row = (xs: number[], first: number[] = [], width = 10) => xs.map((x, i) => ({ x, width, first: first.includes(i) }));
 
@@ -25,5 +25,15 @@ describe('labelsThatFit', () => {
     for (let k = 1; k < kept.length; k++) {
       expect(kept[k].x - kept[k].width / 2).toBeGreaterThanOrEqual(kept[k - 1].x + kept[k - 1].width / 2 + 2);
     }
+  });
+});
+
+describe('gapScale', () => {
+  it('is the widest gap of the take or its truth, at least 8 mm, for a take of hours too', () => {
+    expect(gapScale(Float32Array.of(1, 3, 2))).toBe(8);
+    expect(gapScale(Float32Array.of(1, 9.5, 2), [4, 12])).toBe(12);
+    const hours = new Float32Array(2 * 30 * 3600).fill(2); // spread as Math.max's arguments, this overflowed the stack
+    hours[177_777] = 14;
+    expect(gapScale(hours)).toBe(14);
   });
 });
