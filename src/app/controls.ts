@@ -87,7 +87,7 @@ export function announce(text: string): void {
   if (again && at - announced.at < REPEAT_MS) return;
   announced = { text, at };
   ui.announcer.textContent = again ? '' : text;
-  if (again) setTimeout(() => { if (announced.text === text) ui.announcer.textContent = text; }, 100); // (unless other news came)
+  if (again) setTimeout(() => { if (announced.text === text) ui.announcer.textContent = text; }, 60); // (unless other news came)
 }
 
 /** A change of state: the status line says it and the live region announces it. */
