@@ -60,6 +60,7 @@ export function exportRawFile(animation: Animation, name: string, template: Face
 export async function exportVideoFile(view: { recording: boolean }, player: Player, fps: number, name: string): Promise<void> {
   if (exporting) {
     if (ui.exportVideoButton.getAttribute('aria-busy')) exporting.abort(); // the button again: cancel
+    else tell('A .glb of the take is being prepared: wait for it, or press Escape to cancel it.');
     return;
   }
   const type = videoType();
@@ -67,6 +68,7 @@ export async function exportVideoFile(view: { recording: boolean }, player: Play
   const controller = (exporting = new AbortController());
   const frames = player.take?.frames ?? 0;
   ui.exportVideoButton.setAttribute('aria-busy', 'true');
+  ui.playButton.textContent = 'Pause'; // the take plays for the video (Pause stops both)
   try {
     const seconds = (frames / fps).toFixed(1);
     ui.canvas.scrollIntoView({ block: 'nearest' }); // what is recorded, in sight
@@ -83,5 +85,6 @@ export async function exportVideoFile(view: { recording: boolean }, player: Play
   } finally {
     exporting = null;
     ui.exportVideoButton.removeAttribute('aria-busy');
+    ui.playButton.textContent = player.isPlaying ? 'Pause' : 'Play';
   }
 }

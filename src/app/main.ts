@@ -2,11 +2,9 @@
  * The demo shell: the only code that touches the page's DOM. It loads the face and the model; animates an audio file the
  * visitor opens or drops, a sample clip, or the microphone live; and plays the take back in sync through the shared Player.
  */
-import { loadTemplate } from '../template/face-template';
 import { FaceView } from '../render/face-view';
-import { detectWebGPU } from '../gpu/capabilities';
-import { TalkingFaceEngine, type Backend } from '../engine/engine';
-import { DEFAULT_TEMPLATE_URL, fetchManifest, templateUrlOf } from '../model/artefacts';
+import type { WebGPUSupport } from '../gpu/capabilities';
+import type { TalkingFaceEngine, Backend } from '../engine/engine';
 import { decodeAudio } from '../audio/decode';
 import { Player } from '../player/player';
 import { audioNotes } from '../player/audio-notes';
@@ -21,9 +19,7 @@ import { ui, showStatus, tell, announce, lockWidth, bindControls, enableControls
 import { isolated } from './names';
 import { bindKeys } from './keyboard';
 import { innerLipGaps } from '../template/lip-gap';
-
-/** How long the face, once its template is in, waits for the model's files to reach onnxruntime (start()). */
-const FACE_WAITS_MS = 300;
+import { startLoading } from './startup';
 
 let view: FaceView, player: Player, takeView: TakeView;
 let engine: TalkingFaceEngine | null = null;
@@ -34,7 +30,9 @@ let recording: Recording | null = null, recordPending = false;
 let starting: AbortController | null = null; // Escape cancels a recording still starting (the browser asking for the microphone)
 let finishing = false; // a recording's take being finished
 let headRedraw = false; // the clip being animated is the take's head drawn again
-let lastGpu: Awaited<ReturnType<typeof detectWebGPU>> | null = null;
+let lastGpu: WebGPUSupport | null = null;
+let modelSettled = (): void => undefined;
+const modelTried = new Promise<void>((resolve) => (modelSettled = resolve)); // start() has the model in, or has failed to
 /** The current take's most important note about its audio (silent, no speech, clipped, short), or ''. */
 let takeNote = '';
 const microphones = new MicrophoneChoice(ui.microphoneSelect);
@@ -51,24 +49,12 @@ function publish(): void {
  * each ONNX session is created as soon as its file is in (engine.ts), while the face is being drawn.
  */
 async function start(): Promise<void> {
-  const gpuReady = detectWebGPU();
-  const manifest = fetchManifest(undefined).catch((e: Error) => e);
-  const template = manifest.then((m) => loadTemplate(m instanceof Error ? DEFAULT_TEMPLATE_URL : templateUrlOf(m.manifest, m.manifestUrl)));
-  const engineReady = manifest.then((m) => {
-    if (m instanceof Error) throw m;
-    return TalkingFaceEngine.load({ ...m, template });
-  });
-  // Settled either way; a failure is read below (await engineReady) and is not "unhandled" meanwhile.
-  const engineSettled = engineReady.catch(() => undefined); // read by the await below
-  const [face, gpu] = await Promise.all([template, gpuReady]);
-  // Building and drawing the face holds this thread for most of a second under a software GPU (issue 18): the
-  // model's sessions are handed to onnxruntime's worker first, which creates them meanwhile (a failed load does not
-  // hold the face back, nor do files still on their way after FACE_WAITS_MS: on a slow connection the face comes first).
-  const waited = new Promise((resolve) => setTimeout(resolve, FACE_WAITS_MS));
-  await Promise.race([TalkingFaceEngine.sessionsRequested, engineSettled, waited]);
+  const loading = startLoading();
+  const { template: face, gpu } = await loading.face;
   lastGpu = gpu;
   view = new FaceView(ui.canvas, face, { lifePaused: true }); // still until the model is ready (face-view.ts)
-  player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing') });
+  player = new Player(view, 1, { onFrame: (f) => take && engine && takeView.frameShown(take, engine, f, player.isPlaying), onEnded: () => showPaused('Finished playing'),
+    onBlocked: () => tell('Click or press a key to hear it: the browser plays sound only after a gesture on the page.'), onUnblocked: () => take && tell(`Playing ${isolated(take.name)}.`) });
   takeView = new TakeView(view);
   player.loop = ui.loopCheck.checked; // as ticked while the face loaded, or as the browser restored the page (TakeView too)
   publish();
@@ -76,10 +62,11 @@ async function start(): Promise<void> {
   showStatus('Loading the model…');
   void view.drawn.then(() => (document.body.dataset.ready ||= 'true'));
   try {
-    engine = await engineReady;
+    engine = await loading.engine;
     player.unitsPerMm = engine.unitsPerMm;
     autoBackend = engine.backend;
     if (!gpu.available) ui.backendSelect.querySelector<HTMLOptionElement>('option[value="webgpu"]')!.disabled = true;
+    ui.backendSelect.disabled = false; // (a choice made before the engine was there would not have been applied)
     publish();
     ui.setupInfo.textContent += ` Model ${engine.manifest.model.name}. ${decoderDetails(engine)}`;
     const ready = 'Ready: open or drop an audio file, choose a sample, or press Record.';
@@ -100,11 +87,17 @@ async function start(): Promise<void> {
     document.body.dataset.engine = 'error';
   } finally {
     view.setLifePaused(false); // loaded or not, nothing more competes with the face for the main thread
+    modelSettled();
   }
 }
 
-function needEngine(): TalkingFaceEngine | null {
-  if (!engine) tell('The model is not loaded, so audio cannot be animated. Reload the page to try again.', true);
+/** The model, or null with why not: still loading (`waiting`, when given, is said while it is waited for) or failed. */
+async function needEngine(waiting?: string): Promise<TalkingFaceEngine | null> {
+  const loading = !document.body.dataset.engine;
+  if (loading && waiting) showStatus(waiting);
+  if (loading && waiting) await modelTried;
+  else if (loading) tell('The model is still loading: press Record again once it is ready.');
+  if (!engine && !loading) tell('The model is not loaded, so audio cannot be animated. Reload the page to try again.', true);
   return engine;
 }
 
@@ -114,11 +107,12 @@ const refreshControls = (): void => enableControls({ take: Boolean(take), busy: 
 function setBusy(controller: AbortController | null, isHeadRedraw = false): void {
   [busy, headRedraw] = [controller, isHeadRedraw];
   refreshControls();
+  if (!controller) markSample(ui.sampleSelect, sampleIndex, take?.name); // a sample cancelled or failed is not shown: choosing it again retries
 }
 
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
-  const e = needEngine();
+  const e = engine ?? (await needEngine(`The model is still loading: ${label} is animated once it is in…`)); // (no await once in: Escape at once cancels)
   if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
     if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
     else if (recording || recordPending) tell(recording ? 'Recording: stop it first (Stop recording or Escape), then open a file or a sample.' : 'The recording is starting (the browser may be asking for the microphone): Escape cancels it; then open a file or a sample.');
@@ -139,7 +133,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   } catch (err) {
     if (controller.signal.aborted) {
       if (busy !== controller) return; // another clip took its place: that one speaks for itself
-      tell(`Stopped animating ${label}. Open another file or record.`);
+      tell(headRedraw ? 'Stopped drawing the head again: the take is as it was.' : `Stopped animating ${label}. Open another file or record.`);
       document.body.dataset.take = take ? 'ready' : 'cancelled';
     } else {
       tell(`Could not ${label === 'the sample' ? 'open the sample' : `animate ${label}`}: ${(err as Error).message}`, true);
@@ -157,7 +151,7 @@ function animateFile(file: File): Promise<void> {
     const src = audio.source;
     const { animation, computeMs, samples, notes } = await animateAudio(e, file.name, audio.samples, src.seconds, signal, src.statedSeconds);
     ui.clipInfo.textContent = `${isolated(file.name)}: ${src.seconds.toFixed(1)} s, ${src.channels === 1 ? 'mono' : `${src.channels} channels mixed to mono`}.`;
-    return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend }, notes);
+    return setTake({ animation, buffer: audio.buffer, samples, name: file.name, seconds: src.seconds, computeMs, backend: e.backend, notes });
   });
 }
 
@@ -170,19 +164,18 @@ function openSample(name: string): Promise<void> {
     const audio = await decodeAudio(bytes, e.manifest.audio.sample_rate);
     ui.clipInfo.textContent = `Sample (test split: unseen voice, sentence and face): "${c.text}".`;
     const { animation, computeMs, samples, notes } = await animateAudio(e, 'the sample', audio.samples, c.seconds, signal);
-    const t = setTake({ animation, buffer: audio.buffer, samples, name: c.name, seconds: c.seconds, computeMs, backend: e.backend, truth }, notes);
-    ui.takeInfo.textContent += ` E_vl on this clip: ${takeView.lipError(t, e).toFixed(2)} mm.`;
-    return t;
+    return setTake({ animation, buffer: audio.buffer, samples, name: c.name, seconds: c.seconds, computeMs, backend: e.backend, truth, notes });
   });
 }
 
 /** A take to show and play: its figures in the details, its most important note (if any) kept for the status line. */
-function setTake(t: Take, notes: string[] = []): Take {
+function setTake(t: Take): Take {
+  const notes = t.notes ?? [];
   take = t;
   markSample(ui.sampleSelect, sampleIndex, t.name);
   player.load(t.animation, t.buffer, takeView.drawn(t));
   publish();
-  ui.takeInfo.textContent = takeDetails(t, notes);
+  ui.takeInfo.textContent = takeDetails(t, notes) + (t.truth && engine ? ` E_vl on this clip: ${takeView.lipError(t, engine).toFixed(2)} mm.` : '');
   ui.exportInfo.textContent = '';
   takeNote = notes.length ? `${isolated(t.name)}: ${notes[0]}.` : '';
   ui.playButton.textContent = 'Play'; // loading it stopped any playback
@@ -221,7 +214,8 @@ function stopPlayback(): void {
 
 /** Record starts and stops the microphone take. The button stays enabled (and keeps the focus) while it changes state. */
 async function toggleRecording(): Promise<void> {
-  const e = needEngine();
+  const e = engine;
+  if (!e) await needEngine(); // says why not: still loading, or failed
   if (!e || recordPending) return;
   recordPending = true;
   ui.recordButton.setAttribute('aria-disabled', 'true');
@@ -272,7 +266,7 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
     const speech = await e.restUnlessSpeech(done.animation);
     const notes = audioNotes(done.samples, done.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
-    setTake({ ...done, name: 'Recording', backend: e.backend }, notes);
+    setTake({ ...done, name: 'Recording', backend: e.backend, notes });
     const held = done.heldFrames && `Stopped animating the whole take: it keeps the live frames (the ${done.heldFrames} skipped to keep up hold the frame before them). Press Play.`;
     tell(held || takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';

@@ -28,6 +28,8 @@ export interface Take {
   truth?: Truth;
   /** E_vl of the whole take against its ground truth (mm), computed once. */
   lipError?: number;
+  /** What was noticed about its audio (silent, no speech found, clipped, short), the most important first. */
+  notes?: string[];
 }
 
 export class TakeView {
@@ -171,7 +173,7 @@ export async function redrawHead(e: TalkingFaceEngine, t: Take, signal: AbortSig
       signal,
       onProgress: (done, total) => showStatus(`Drawing the head's motion again: frame ${done} of ${total}…`),
     });
-    return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined };
+    return { ...t, animation, computeMs: performance.now() - t0, lipError: undefined, heldFrames: undefined }; // (all its frames made anew)
   } finally {
     signal.removeEventListener('abort', undo);
   }

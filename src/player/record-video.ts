@@ -46,6 +46,7 @@ export async function recordTake(canvas: HTMLCanvasElement, view: { recording: b
   let video: MediaStream | null = null, recorder: MediaRecorder | null = null;
   view.recording = true; // drawn even where scrolled out of sight (else the video has no picture)
   try {
+    player.stop(); // a playback under way would draw its frames over the first one until play() below
     player.show(0); // the first frame the recorder sees is the take's first, not whatever was shown
     // (a hidden tab draws no frames: the signal still cancels this wait)
     await new Promise<void>((r) => {

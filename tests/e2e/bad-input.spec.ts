@@ -46,6 +46,26 @@ test.describe('the demo with unusual audio', () => {
   });
 });
 
+test('a file opened while the model loads is animated once it is in; Record then says to wait; the decoder waits too', async ({ page }) => {
+  test.setTimeout(90_000);
+  await page.route('**/models/gava.safetensors', async (route) => {
+    await new Promise((resolve) => setTimeout(resolve, 5000)); // a slow connection
+    await route.continue();
+  });
+  await page.goto('/');
+  await expect(page.locator('body')).toHaveAttribute('data-ready', 'true', { timeout: 30_000 });
+  expect(await page.locator('body').getAttribute('data-engine')).toBeNull();
+  await expect(page.locator('#backend-select'), 'no choice that could not be applied yet').toBeDisabled();
+  await page.locator('#record-button').click();
+  await expect(page.locator('#status')).toHaveText('The model is still loading: press Record again once it is ready.');
+  await expect(page.locator('#status')).not.toHaveClass(/error/);
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await expect(page.locator('#status')).toHaveText('The model is still loading: speech-kal.wav is animated once it is in…');
+  await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
+  await expect(page.locator('#play-button')).toHaveText('Pause'); // and played, as a file opened once it was in
+  await expect(page.locator('#backend-select')).toBeEnabled();
+});
+
 test.describe('the demo with a broken model', () => {
   test('a corrupt model file is reported and the face can still be viewed', async ({ page }) => {
     await page.route('**/models/gava.safetensors', (route) => route.fulfill({ status: 200, contentType: 'application/octet-stream', body: Buffer.from('not the weights') }));

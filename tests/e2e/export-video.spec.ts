@@ -68,10 +68,13 @@ test('Export video saves the take playing, picture and sound; Escape cancels one
 
   const later: string[] = [];
   page.on('download', (d) => later.push(d.suggestedFilename()));
+  await expect(page.locator('#play-button')).toHaveText('Play'); // (the take played out)
   await page.locator('#export-video').click();
   await expect(page.locator('#status')).toContainText('Recording the video');
+  await expect(page.locator('#play-button'), 'the take plays for the video: Pause would stop it').toHaveText('Pause');
   await page.keyboard.press('Escape');
   await expect(page.locator('#status')).toContainText('Video cancelled.');
+  await expect(page.locator('#play-button')).toHaveText('Play');
   await page.waitForTimeout(500);
   expect(later).toEqual([]);
 });

@@ -80,7 +80,7 @@ test('New head motion draws the next seed; one stopped before it is drawn leaves
     document.getElementById('head-reroll')!.click();
     document.dispatchEvent(new KeyboardEvent('keydown', { key: 'Escape', bubbles: true, cancelable: true }));
   });
-  await expect(page.locator('#status')).toContainText('Stopped animating');
+  await expect(page.locator('#status')).toHaveText('Stopped drawing the head again: the take is as it was.');
   expect(await seed(), 'the seed of the head still shown').toBe(0);
   await expect(page.locator('body')).toHaveAttribute('data-head-seed', '0');
   expect(await pose()).toEqual(first);
@@ -93,4 +93,5 @@ test('New head motion draws the next seed; one stopped before it is drawn leaves
   }, null, { timeout: 60_000 });
   expect(await seed(), 'the next seed, none skipped').toBe(1);
   expect(await pose()).not.toEqual(first);
+  await expect(page.locator('#details'), 'the sample\'s E_vl is kept with its new head').toContainText(/E_vl on this clip: \d+\.\d\d mm/);
 });

@@ -121,6 +121,8 @@ test('the demo\'s sample whose download hangs: Escape stops it at once, and anot
   await page.waitForTimeout(500);
   await page.keyboard.press('Escape');
   await expect(page.locator('#status')).toContainText('Stopped animating the sample', { timeout: 2_000 });
+  // The menu goes back to what is shown (no take yet): choosing that sample again would be a choice, not nothing.
+  await expect(page.locator('#sample-select')).toHaveValue('');
   await page.locator('#sample-select').selectOption((await options.nth(2).getAttribute('value'))!);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
 });
