@@ -12,7 +12,7 @@ export type { Backend, EngineOptions, AnimateOptions, Animation, Frames, StageTi
 export { LiveSession, type LiveOptions } from './engine/live';
 export { decodeAudio, levels, AudioDecodeError, SILENT_PEAK, type DecodedAudio } from './audio/decode';
 export { openMicrophone, listMicrophones, AudioCapture, MicrophoneError, type CaptureOptions, type Microphone } from './audio/capture';
-export { StreamResampler } from './audio/resample';
+export { StreamResampler, resampleAll } from './audio/resample';
 export { speakStream, type PageStreamOptions } from './player/page-stream';
 export type { SpeechStream, MediaSpeechStream } from './player/speech-stream';
 export type { SpeechStreamOptions, WrittenSpeechOptions, MediaSpeechOptions, StreamDelayOption, StreamTake } from './player/stream-options';

@@ -1,10 +1,11 @@
 /**
  * Audio in: any file the browser can decode (wav, mp3, ogg/opus, webm, m4a where supported), a Blob,
- * or an AudioBuffer -> mono Float32Array at the model's sample rate. The channels are mixed here (mixToMono), the
- * resampling is the browser's (an OfflineAudioContext). A file the browser cannot decode gets a reason from its
+ * or an AudioBuffer -> mono Float32Array at the model's sample rate. The browser decodes (at 44.1 kHz, or the
+ * AudioBuffer's rate); the channels are mixed (mixToMono) and brought to the model's rate (resampleAll) here. A file the browser cannot decode gets a reason from its
  * first bytes where they tell one (sniff.ts). Library code: Web Audio, no DOM.
  */
 import { CONVERT, statedSecondsIfCut, undecodableReason } from './sniff';
+import { resampleAll } from './resample';
 
 export class AudioDecodeError extends Error {
   override name = 'AudioDecodeError';
@@ -32,11 +33,11 @@ export function decodeAudio(input: ArrayBuffer | Blob | AudioBuffer, sampleRate:
   return new Promise((resolve, reject) => {
     const stop = () => reject(signal.reason);
     signal.addEventListener('abort', stop, { once: true });
-    decodeNow(input, sampleRate).then(resolve, reject).finally(() => signal.removeEventListener('abort', stop));
+    decodeNow(input, sampleRate, signal).then(resolve, reject).finally(() => signal.removeEventListener('abort', stop));
   });
 }
 
-async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number): Promise<DecodedAudio> {
+async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: number, signal?: AbortSignal): Promise<DecodedAudio> {
   let buffer: AudioBuffer;
   let statedSeconds: number | null = null;
   if (input instanceof AudioBuffer) buffer = input;
@@ -57,19 +58,10 @@ async function decodeNow(input: ArrayBuffer | Blob | AudioBuffer, sampleRate: nu
   const source = { decodedRate: buffer.sampleRate, channels: buffer.numberOfChannels, seconds: buffer.duration, statedSeconds };
   const channels = Array.from({ length: buffer.numberOfChannels }, (_, c) => buffer.getChannelData(c));
   if (buffer.sampleRate === sampleRate) return { samples: mixToMono(channels), sampleRate, buffer, source };
-  let mono = buffer; // resampled as it is where it has one channel (a long clip is not copied first)
-  if (channels.length > 1) {
-    mono = new AudioBuffer({ length: buffer.length, numberOfChannels: 1, sampleRate: buffer.sampleRate });
-    mono.copyToChannel(mixToMono(channels), 0);
-  }
-  const frames = Math.max(1, Math.round(buffer.duration * sampleRate));
-  const offline = new OfflineAudioContext(1, frames, sampleRate);
-  const node = offline.createBufferSource();
-  node.buffer = mono;
-  node.connect(offline.destination);
-  node.start();
-  const rendered = await offline.startRendering();
-  return { samples: rendered.getChannelData(0).slice(), sampleRate, buffer, source };
+  // Not a Web Audio source node into a context at the model's rate: Chromium's interpolates with no low-pass, and a
+  // fricative's hiss above the model's band came out folded into it (training resamples with sox's low-pass).
+  const mono = channels.length > 1 ? mixToMono(channels) : channels[0]; // (one channel is not copied first)
+  return { samples: await resampleAll(mono, buffer.sampleRate, sampleRate, signal), sampleRate, buffer, source };
 }
 
 /** 5.1's channels (L, R, C, LFE, SL, SR) in Web Audio's down-mix to mono: the centre, the front pair, the surrounds. */

@@ -1,4 +1,5 @@
-/** Resampling a stream as it comes (the microphone at the device's rate, speech written at its own rate) to the model's. */
+/** Resampling a stream as it comes (the microphone at the device's rate, speech written at its own rate) or a whole clip to the model's. */
+import { yieldToEventLoop } from '../engine/frames';
 
 /**
  * Linear-phase low-pass + fractional resampling, streaming: pieces in at `from` Hz, pieces out at
@@ -40,7 +41,8 @@ export class StreamResampler {
     joined.set(input, this.history.length);
     const base = this.received - this.history.length; // input index of joined[0]
     this.received += input.length;
-    const out: number[] = [];
+    const out = new Float32Array(Math.ceil(((joined.length + 1) * this.phases) / this.step) + 1); // (at most this many come out)
+    let n = 0;
     const w = this.table ? null : new Float32Array(2 * this.half);
     // Output n sits at input time centre + phase / phases; it needs inputs up to centre + half.
     for (;;) {
@@ -48,18 +50,23 @@ export class StreamResampler {
       if (centre + this.half >= this.received) break;
       const phase = (this.made * this.step) % this.phases;
       const row = this.table ? this.table.subarray(phase * 2 * this.half, (phase + 1) * 2 * this.half) : this.weights(phase / this.phases, w!);
+      const first = centre - this.half + 1 - base; // joined's index of the first tap
       let s = 0;
-      for (let j = 0, k = centre - this.half + 1; j < row.length; j++, k++) {
-        const i = k - base;
-        if (k >= 0 && i >= 0 && i < joined.length) s += row[j] * joined[i];
+      if (first >= 0) { // every tap in joined (all but the stream's first outputs; the last tap always is)
+        for (let j = 0; j < row.length; j++) s += row[j] * joined[first + j];
+      } else {
+        for (let j = 0, k = centre - this.half + 1; j < row.length; j++, k++) {
+          const i = k - base;
+          if (k >= 0 && i >= 0 && i < joined.length) s += row[j] * joined[i];
+        }
       }
-      out.push(s);
+      out[n++] = s;
       this.made++;
     }
     const next = Math.floor(this.made / this.phases) * this.step + Math.floor(((this.made % this.phases) * this.step) / this.phases);
     const keepFrom = Math.max(0, next - this.half - base);
     this.history = joined.slice(keepFrom);
-    return Float32Array.from(out);
+    return out.slice(0, n);
   }
 
   /** The kernel's weights for an output `fraction` (0..1) past its centre sample, taps centre - half + 1 .. centre + half, summing to 1. */
@@ -72,6 +79,36 @@ export class StreamResampler {
     for (let j = 0; j < into.length; j++) into[j] /= sum;
     return into;
   }
+}
+
+/** How long resampleAll works before it lets the page handle input and drawing (and checks its signal), ms. */
+const SLICE_MS = 25;
+
+/**
+ * A whole clip from `from` Hz to `to` Hz through StreamResampler's low-pass (what lies above the lower Nyquist frequency
+ * is removed, not folded into the band below it): round(length * to / from) samples, aligned with the input. An hour
+ * takes seconds: it works a second of audio at a time, letting the page run between slices; `signal` stops it.
+ */
+export async function resampleAll(input: Float32Array, from: number, to: number, signal?: AbortSignal): Promise<Float32Array<ArrayBuffer>> {
+  const resampler = new StreamResampler(from, to);
+  const out = new Float32Array(Math.max(1, Math.round((input.length * to) / from)));
+  let made = 0;
+  const keep = (piece: Float32Array) => {
+    const n = Math.min(piece.length, out.length - made);
+    out.set(piece.subarray(0, n), made);
+    made += n;
+  };
+  let slice = performance.now();
+  for (let at = 0; at < input.length; at += from) {
+    keep(resampler.push(input.subarray(at, at + from)));
+    if (performance.now() - slice < SLICE_MS) continue;
+    await yieldToEventLoop();
+    signal?.throwIfAborted();
+    slice = performance.now();
+  }
+  // It holds back half its kernel: zeros after the end bring the last samples out.
+  keep(resampler.push(new Float32Array(Math.ceil(resampler.delaySeconds * from) + 2)));
+  return out;
 }
 
 function gcd(a: number, b: number): number {

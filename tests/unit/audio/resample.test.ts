@@ -1,6 +1,6 @@
-/** The streaming resampler (src/audio/resample.ts): behind live capture when the AudioContext cannot run at the model's rate, and behind speakStream(). */
+/** The streaming resampler (src/audio/resample.ts): behind live capture when the AudioContext cannot run at the model's rate, behind speakStream(), and (resampleAll) behind decodeAudio(). */
 import { describe, expect, it } from 'vitest';
-import { StreamResampler } from '../../../src/audio/resample';
+import { StreamResampler, resampleAll } from '../../../src/audio/resample';
 
 const tone = (hz: number, rate: number, n: number) => Float32Array.from({ length: n }, (_, i) => Math.sin((2 * Math.PI * hz * i) / rate));
 
@@ -59,5 +59,29 @@ describe('StreamResampler', () => {
   it('passes the stream through at equal rates', () => {
     const x = tone(300, 16000, 1000);
     expect(Array.from(new StreamResampler(16000, 16000).push(x))).toEqual(Array.from(x));
+  });
+});
+
+describe('resampleAll', () => {
+  it('is the stream resampler\'s output, its tail included, length * to / from samples in step with the input', async () => {
+    const x = tone(300, 44100, 3 * 44100 + 77).map((v, i) => v + 0.3 * Math.sin(i * 0.37));
+    const all = await resampleAll(x, 44100, 16000);
+    expect(all.length).toBe(Math.round((x.length * 16000) / 44100));
+    const r = new StreamResampler(44100, 16000);
+    const streamed = Float32Array.from([...pushAll(r, x, [1000]), ...r.push(new Float32Array(200))]).subarray(0, all.length);
+    expect(Math.max(...all.map((v, i) => Math.abs(v - streamed[i])))).toBeLessThan(1e-6);
+    // The last samples are the input's, brought out by the tail (not zeros): a 440 Hz tone is in place to the end.
+    const t = await resampleAll(tone(440, 48000, 48000), 48000, 16000);
+    expect(t.length).toBe(16000);
+    for (const n of [0, 15990, 15995]) expect(t[n]).toBeCloseTo(Math.sin((2 * Math.PI * 440 * n) / 16000), 1);
+    expect(Math.abs(t[15999])).toBeGreaterThan(0); // (not cut short)
+  });
+
+  it('stops at its signal between slices of a long clip', async () => {
+    const stop = new AbortController();
+    const long = tone(440, 48000, 48000 * 120); // two minutes: several slices
+    const made = resampleAll(long, 48000, 16000, stop.signal);
+    stop.abort(new Error('cancelled'));
+    await expect(made).rejects.toThrow('cancelled');
   });
 });
