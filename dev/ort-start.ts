@@ -11,10 +11,11 @@ import { PoseEncoder } from '../src/encoders/pose';
 
 async function main(): Promise<void> {
   // As TalkingFaceEngine.load does without a hardware GPU, before any file has arrived; ?stallSeconds=N as load's
-  // option; ?providers=webgpu as it does on a hardware GPU (onnxruntime's WebGPU build, in the page).
+  // option; ?providers=webgpu as it does on a hardware GPU (onnxruntime's WebGPU build, in the page), or a list
+  // tried in order (webgpu,wasm).
   const query = new URLSearchParams(location.search);
   const stall = query.get('stallSeconds');
-  const providers: ExecutionProvider[] = query.get('providers') === 'webgpu' ? ['webgpu'] : ['wasm'];
+  const providers = (query.get('providers') ?? 'wasm').split(',') as ExecutionProvider[];
   startOrt(providers, stall ? Number(stall) : undefined);
   const { manifest, files, template } = await fetchArtefacts();
   void template.catch(() => undefined); // fetched as the engine fetches it, not needed here

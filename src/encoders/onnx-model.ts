@@ -121,20 +121,28 @@ export class OnnxModel {
     return this.runner.inputNames;
   }
 
+  /**
+   * The session on the first of `providers` that creates it. One that fails for any reason, its runtime included (the
+   * WebGPU build, 28 MB, is more than some static hosts serve), gives way to the next; a model file that does not
+   * match this build fails at once. With one failure, its own error (what to do); with more, all of them.
+   */
   static async create(spec: SessionSpec, providers: ExecutionProvider[] = PROVIDER_PRIORITY): Promise<OnnxModel> {
-    const errors: string[] = [];
+    const errors: Error[] = [];
     for (const provider of providers) {
+      let runner: Runner;
       try {
-        const runner = await OnnxModel.runner(spec, provider);
-        const missing = Object.keys(spec.inputs).filter((n) => !runner.inputNames.includes(n));
-        if (missing.length) throw new ModelLoadError(`${spec.name}: the model file has no input ${missing.join(', ')} (inputs: ${runner.inputNames.join(', ')}); models/ does not match this build`);
-        return new OnnxModel(spec.name, runner, provider, spec.inputs);
+        runner = await OnnxModel.runner(spec, provider);
       } catch (e) {
-        if (e instanceof ModelLoadError) throw e;
-        errors.push(`${provider}: ${(e as Error).message}`);
+        errors.push(e as Error);
+        if (provider !== providers.at(-1)) console.warn(`${spec.name}: the ${provider} provider failed (${(e as Error).message}); trying the next`);
+        continue;
       }
+      const missing = Object.keys(spec.inputs).filter((n) => !runner.inputNames.includes(n));
+      if (missing.length) throw new ModelLoadError(`${spec.name}: the model file has no input ${missing.join(', ')} (inputs: ${runner.inputNames.join(', ')}); models/ does not match this build`);
+      return new OnnxModel(spec.name, runner, provider, spec.inputs);
     }
-    throw new ModelLoadError(`could not load ${spec.name} with any execution provider (${errors.join('; ')})`);
+    if (errors.length === 1 && errors[0] instanceof ModelLoadError) throw errors[0];
+    throw new ModelLoadError(`could not load ${spec.name} with any execution provider (${errors.map((e, i) => `${providers[i]}: ${e.message}`).join('; ')})`);
   }
 
   /** The wasm provider in onnxruntime's worker where there is one; the page's thread otherwise, or if the worker fails. */

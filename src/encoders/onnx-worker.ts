@@ -69,8 +69,8 @@ self.onmessage = (e: MessageEvent<Message>) => {
     self.postMessage({ type: 'started' });
     return;
   }
-  queue = queue.then(() => handle(m)).then(
-    ({ reply, transfer }) => self.postMessage(reply, { transfer }),
-    (err: unknown) => self.postMessage({ id: m.id, error: err instanceof Error ? err.message : String(err) }),
-  );
+  // Every job is answered, its reply's own failure included (an output that cannot be sent): its caller never waits
+  // for ever, and the queue goes on to the next job.
+  queue = queue.then(() => handle(m)).then(({ reply, transfer }) => self.postMessage(reply, { transfer }))
+    .catch((err: unknown) => self.postMessage({ id: m.id, error: err instanceof Error ? err.message : String(err) }));
 };

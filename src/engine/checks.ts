@@ -1,5 +1,6 @@
 /** The engine's arguments, checked: a wrong one is a TypeError or RangeError that names it, never a silent wrong result. */
 import type { Backend } from './backends';
+export { checkedStallSeconds } from '../model/fetch-body';
 
 /** Far beyond any audio scale (floats in [-1, 1], 16- or 32-bit integers); the Mel power of larger values overflows float32. */
 const MAX_SAMPLE = 1e12;

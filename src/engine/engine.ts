@@ -27,7 +27,7 @@ import { LiveSession, type LiveOptions } from './live';
 import { emptyBlendshapes, setBlendshapes, yieldToEventLoop, type Animation, type Frames, type StageTimes } from './frames';
 import { speechFound } from '../encoders/voice-activity';
 import { levels, SILENT_PEAK } from '../audio/decode';
-import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedSeed, checkedWorkers } from './checks';
+import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedSeed, checkedStallSeconds, checkedWorkers } from './checks';
 import { ortThreads } from '../encoders/ort-worker-client';
 import { allOrFree } from '../model/all-or-free';
 
@@ -46,8 +46,8 @@ const CPU_ASKED = { available: false, description: 'not asked for (backend cpu)'
 
 export class TalkingFaceEngine {
   /**
-   * Resolves once load() has asked onnxruntime for every session of the model: where the page can start a worker,
-   * onnxruntime creates them there, and the page's main thread is free for work of its own meanwhile.
+   * Resolves once load() has asked onnxruntime for every session of the model (or has failed: nothing more is asked):
+   * where the page can start a worker, onnxruntime creates them there, and the page's main thread is free meanwhile.
    */
   static readonly sessionsRequested: Promise<void> = new Promise((resolve) => (markSessionsRequested = resolve));
 
@@ -55,11 +55,18 @@ export class TalkingFaceEngine {
 
   private constructor(private readonly pipeline: Pipeline) {}
 
-  static async load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
+  static load(options: EngineOptions = {}): Promise<TalkingFaceEngine> {
+    const loading = TalkingFaceEngine.loaded(options);
+    loading.catch(() => markSessionsRequested()); // failed: nothing more is asked (the caller gets the error from `loading`)
+    return loading;
+  }
+
+  private static async loaded(options: EngineOptions): Promise<TalkingFaceEngine> {
     if (options.backend !== undefined) checkedBackend(options.backend);
     if (options.cpuWorkers !== undefined) checkedWorkers(options.cpuWorkers);
     if (options.headMotionSeed !== undefined) checkedSeed(options.headMotionSeed); // (before anything is loaded for nothing)
     if (options.headMotionScale !== undefined) checkedScale(options.headMotionScale);
+    if (options.stallSeconds !== undefined) checkedStallSeconds(options.stallSeconds);
     // onnxruntime starts loading as soon as the providers are known, and each ONNX session is requested as soon as its
     // file has arrived, while the others are still on their way: the model is ready sooner than if every file were awaited first.
     // (Both awaited together: a file that fails while the adapter is being asked for is then still handled below.)
@@ -97,9 +104,7 @@ export class TalkingFaceEngine {
     return this.pipeline.manifest;
   }
 
-  get template(): FaceTemplate {
-    return this.pipeline.template;
-  }
+  get template(): FaceTemplate { return this.pipeline.template; }
 
   /** Milliseconds per stage since resetTimes(). */
   get times(): StageTimes {
@@ -163,9 +168,7 @@ export class TalkingFaceEngine {
     return 1 / this.pipeline.mmPerUnit;
   }
 
-  get fps(): number {
-    return this.pipeline.fps;
-  }
+  get fps(): number { return this.pipeline.fps; }
 
   /** Frames produced for `samples` samples: round(duration * fps). */
   frameCount(samples: number): number {

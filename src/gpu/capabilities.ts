@@ -14,6 +14,9 @@ export interface WebGPUSupport {
 
 let cached: Promise<WebGPUSupport> | null = null;
 
+/** How long the browser may take to answer for an adapter before the page goes on without WebGPU (the spec lets it wait). */
+const ADAPTER_WAIT_MS = 10_000;
+
 /** A hardware adapter: what 'auto' chooses WebGPU for (a software one, SwiftShader, is slower than the CPU path). */
 export function isHardwareAdapter(support: WebGPUSupport): boolean {
   return Boolean(support.adapter && !support.info?.isFallbackAdapter);
@@ -31,18 +34,26 @@ async function probe(): Promise<WebGPUSupport> {
     return { available: false, description: 'no WebGPU in this browser (navigator.gpu is missing)', adapter: null, info: null };
   }
   let adapter: GPUAdapter | null;
+  let timer: ReturnType<typeof setTimeout> | undefined;
   try {
-    adapter = await gpu.requestAdapter();
+    adapter = await Promise.race([gpu.requestAdapter(), new Promise<never>((_, reject) => {
+      timer = setTimeout(() => reject(new Error(`no answer within ${ADAPTER_WAIT_MS / 1000} s`)), ADAPTER_WAIT_MS);
+    })]);
   } catch (e) {
+    cached = null; // asked again next time (the answer may come then)
     return { available: false, description: `WebGPU adapter request failed: ${(e as Error).message}`, adapter: null, info: null };
+  } finally {
+    clearTimeout(timer);
   }
   if (!adapter) {
     return { available: false, description: 'WebGPU is present but no adapter was found', adapter: null, info: null };
   }
-  const raw = adapter.info;
-  // isFallbackAdapter moved from GPUAdapter to GPUAdapterInfo; read both.
-  const isFallbackAdapter = Boolean((raw as { isFallbackAdapter?: boolean }).isFallbackAdapter ?? (adapter as { isFallbackAdapter?: boolean }).isFallbackAdapter);
-  const info = { vendor: raw.vendor, architecture: raw.architecture, device: raw.device, isFallbackAdapter };
+  // GPUAdapter.info came in Chrome 127 (before it, an async requestAdapterInfo()); isFallbackAdapter moved from
+  // GPUAdapter to GPUAdapterInfo: read whichever there is.
+  const legacy = adapter as GPUAdapter & { isFallbackAdapter?: boolean; requestAdapterInfo?: () => Promise<GPUAdapterInfo> };
+  const raw: Partial<GPUAdapterInfo> & { isFallbackAdapter?: boolean } = adapter.info ?? (await legacy.requestAdapterInfo?.().catch(() => undefined)) ?? {}; // (unnamed, then)
+  const isFallbackAdapter = Boolean(raw.isFallbackAdapter ?? legacy.isFallbackAdapter);
+  const info = { vendor: raw.vendor ?? '', architecture: raw.architecture ?? '', device: raw.device ?? '', isFallbackAdapter };
   const name = [info.vendor, info.architecture, info.device].filter(Boolean).join(' ') || 'unnamed adapter';
   return {
     available: true,

@@ -8,6 +8,15 @@
 /** Seconds a download may bring nothing before it fails (the default of every `stallSeconds`). */
 export const STALL_SECONDS = 30;
 
+/** The longest a browser timer waits (about 24.8 days); a longer stallSeconds is as Infinity: never. */
+const MAX_TIMER_MS = 2 ** 31 - 1;
+
+/** `stallSeconds` if it is a positive number of seconds (Infinity: a download never fails for bringing nothing), else a RangeError. */
+export function checkedStallSeconds(seconds: unknown): number {
+  if (typeof seconds === 'number' && seconds > 0) return seconds;
+  throw new RangeError(`stallSeconds must be a positive number of seconds (Infinity: downloads never time out), not ${String(seconds)}`);
+}
+
 /** Nothing arrived for `stallSeconds`; the message says so and what to do, for the caller to name what was being fetched. */
 export class StalledError extends Error {
   override name = 'StalledError';
@@ -27,16 +36,17 @@ export interface FetchBodyOptions {
   signal?: AbortSignal;
 }
 
-/** The response to `url` and its whole body; StalledError once nothing has arrived for `stallSeconds`; fetch's own errors as they are. */
+/** The response to `url` and its whole body; StalledError once nothing has arrived for `stallSeconds`; fetch's own errors as they are; a RangeError for a stallSeconds that is no positive number. */
 export async function fetchBody(url: string | URL, options: FetchBodyOptions = {}): Promise<FetchedBody> {
   options.signal?.throwIfAborted();
   const fetchFn = options.fetch ?? fetch.bind(globalThis);
-  const seconds = options.stallSeconds ?? STALL_SECONDS;
+  const seconds = checkedStallSeconds(options.stallSeconds ?? STALL_SECONDS);
   const abort = new AbortController();
-  let timer = setTimeout(() => abort.abort(), seconds * 1000);
+  const arm = () => (seconds * 1000 <= MAX_TIMER_MS ? setTimeout(() => abort.abort(), seconds * 1000) : undefined); // (longer: never)
+  let timer = arm();
   const alive = () => {
     clearTimeout(timer);
-    timer = setTimeout(() => abort.abort(), seconds * 1000);
+    timer = arm();
   };
   const said = `nothing arrived for ${seconds} s; check the connection and try again`;
   const stalled = new Promise<never>((_, reject) => abort.signal.addEventListener('abort', () => reject(new StalledError(said)), { once: true }));

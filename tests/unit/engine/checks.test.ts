@@ -37,3 +37,12 @@ describe('the engine\'s argument checks', () => {
     for (const bad of [3, -1, 1.5, NaN, '2']) expect(() => checkedLayer(bad, 3)).toThrow(/layer must be a whole number from 0 to 2 \(the decoder's layers count from 0\)/);
   });
 });
+
+describe('TalkingFaceEngine.load\'s failure', () => {
+  it('a load refused at once (a stallSeconds that is no positive number) still settles sessionsRequested: nothing more is asked', async () => {
+    const { TalkingFaceEngine } = await import('../../../src/engine/engine');
+    await expect(TalkingFaceEngine.load({ stallSeconds: -1 })).rejects.toThrow(/stallSeconds must be a positive number/);
+    const waited = await Promise.race([TalkingFaceEngine.sessionsRequested.then(() => 'settled'), new Promise((r) => setTimeout(() => r('waiting for ever'), 50))]);
+    expect(waited).toBe('settled');
+  });
+});

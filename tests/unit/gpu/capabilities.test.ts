@@ -34,6 +34,28 @@ describe('detectWebGPU', () => {
     expect(a.info?.isFallbackAdapter).toBe(true);
   });
 
+  it('reads an adapter of a browser before GPUAdapter.info (Chrome 113-126): its async info, or none, not a TypeError', async () => {
+    const older = { requestAdapterInfo: async () => ({ vendor: 'acme', architecture: 'gen9', device: '' }), isFallbackAdapter: false, requestDevice: vi.fn() };
+    expect(await (await fresh({ requestAdapter: async () => older })).detectWebGPU()).toMatchObject({ available: true, description: 'acme gen9' });
+    const bare = { requestDevice: vi.fn() };
+    expect(await (await fresh({ requestAdapter: async () => bare })).detectWebGPU()).toMatchObject({ available: true, description: 'unnamed adapter' });
+  });
+
+  it('an adapter request that never answers: the page goes on without WebGPU after a while, and asks again next time', async () => {
+    vi.useFakeTimers();
+    try {
+      const requestAdapter = vi.fn(() => new Promise<never>(() => undefined));
+      const m = await fresh({ requestAdapter });
+      const probed = m.detectWebGPU();
+      await vi.advanceTimersByTimeAsync(10_000);
+      expect(await probed).toMatchObject({ available: false, description: expect.stringMatching(/no answer within 10 s/) });
+      void m.detectWebGPU();
+      expect(requestAdapter).toHaveBeenCalledTimes(2);
+    } finally {
+      vi.useRealTimers();
+    }
+  });
+
   it('shares one device, and retries after a failed device request', async () => {
     const device = { lost: new Promise(() => undefined) };
     const requestDevice = vi.fn().mockRejectedValueOnce(new Error('out of memory')).mockResolvedValue(device);

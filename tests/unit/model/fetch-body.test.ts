@@ -38,6 +38,16 @@ describe('fetchBody', () => {
     expect(Date.now() - t0).toBeLessThan(2000);
   });
 
+  it('never times out with stallSeconds Infinity (or longer than a timer can wait); refuses one that is no positive number', async () => {
+    for (const stallSeconds of [Infinity, 3e6]) {
+      const body = await fetchBody('http://test/a', { fetch: served(() => streaming(2, 30, true)), stallSeconds });
+      expect(body.bytes.byteLength, `stallSeconds ${stallSeconds}`).toBe(200); // (a timer past 2^31 ms fired at once)
+    }
+    for (const stallSeconds of [0, -1, NaN, '30']) {
+      await expect(fetchBody('http://test/a', { fetch: served(() => streaming(1, 0, true)), stallSeconds: stallSeconds as number })).rejects.toThrow(RangeError);
+    }
+  });
+
   it('fails when the headers never come, even from a fetch that ignores its abort signal', async () => {
     await expect(fetchBody('http://test/a', { fetch: (() => never()) as typeof fetch, stallSeconds: 0.1 })).rejects.toThrow('nothing arrived for 0.1 s');
     const aborting: typeof fetch = (_url, init) => new Promise((_, reject) => init!.signal!.addEventListener('abort', () => reject(new DOMException('aborted', 'AbortError'))));
