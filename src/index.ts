@@ -14,6 +14,7 @@ export { decodeAudio, levels, AudioDecodeError, SILENT_PEAK, type DecodedAudio }
 export { openMicrophone, listMicrophones, AudioCapture, MicrophoneError, type CaptureOptions, type Microphone } from './audio/capture';
 export { StreamResampler, resampleAll } from './audio/resample';
 export { speakStream, type PageStreamOptions } from './player/page-stream';
+export { heardTime } from './player/stream-timeline';
 export type { SpeechStream, MediaSpeechStream } from './player/speech-stream';
 export type { SpeechStreamOptions, WrittenSpeechOptions, MediaSpeechOptions, StreamDelayOption, StreamTake } from './player/stream-options';
 export type { PcmChunk } from './audio/pcm';

@@ -249,9 +249,9 @@ export class TalkingFaceElement extends ElementBase {
 
   private load(): Promise<TalkingFaceEngine> {
     if (!this.loading) {
-      const model = this.getAttribute('model') || DEFAULT_MODEL;
+      const model = this.getAttribute('model')?.trim() || DEFAULT_MODEL; // (as loadKey reads it: blank is none)
       this.status.set('Loading the model…');
-      const hold = (this.hold = holdEngine(model, this.getAttribute('template'), backendAttribute(this.getAttribute('backend'))));
+      const hold = (this.hold = holdEngine(model, this.getAttribute('template')?.trim() || null, backendAttribute(this.getAttribute('backend'))));
       this.loading = hold.engine.then(
         (engine) => {
           if (this.hold !== hold) return engine; // released meanwhile (removed, or another model or backend)
@@ -287,7 +287,7 @@ export class TalkingFaceElement extends ElementBase {
     const engine = this.engine;
     if (!engine || !this.isConnected) return; // removed (or reloading) while the model loaded: nothing to show or start
     if (!this.stage.view) {
-      const avatar = this.getAttribute('avatar');
+      const avatar = this.getAttribute('avatar')?.trim() || null;
       if (avatar) this.status.set('Loading the avatar…');
       try {
         if (!(await this.stage.make(engine.template, engine.unitsPerMm, avatar, avatarAttributes(this)))) return; // superseded

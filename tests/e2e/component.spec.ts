@@ -190,6 +190,20 @@ test('a model replaced while it loads reports nothing of its own failure; the ne
   expect(seen).toEqual(['ready']);
 });
 
+test('blank model, template and avatar attributes (a template that writes model="{{ url }}" with no url) mean none: the default face is ready', async ({ page }) => {
+  test.setTimeout(60_000);
+  await page.goto('/examples/embed.html');
+  const seen = await page.evaluate(() => new Promise<string[]>((resolve) => {
+    const got: string[] = [];
+    const el = document.createElement('talking-face');
+    for (const name of ['model', 'template', 'avatar']) el.setAttribute(name, '  ');
+    el.addEventListener('error', (e) => got.push(`error: ${(e as CustomEvent).detail.message}`));
+    el.addEventListener('ready', () => setTimeout(() => resolve([...got, 'ready']), 300));
+    document.body.append(el);
+  }));
+  expect(seen).toEqual(['ready']);
+});
+
 test('ready says how many threads the work runs on: onnxruntime\'s only where the page is cross-origin isolated', async ({ page, context }) => {
   test.setTimeout(90_000);
   const threads = () => page.evaluate(() => new Promise<{ isolated: boolean; cores: number; threads: { encoders: number; decoder: number } }>((resolve) => {
