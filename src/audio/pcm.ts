@@ -10,14 +10,24 @@ export type PcmChunk = Float32Array | Int16Array | ArrayBuffer | SharedArrayBuff
 export const MIN_STREAM_RATE = 8000;
 export const MAX_STREAM_RATE = 96000;
 
-/** Turns pieces into samples, keeping a byte that a piece of 16-bit PCM ended on for the next piece. */
+/** The most bytes a WAV header at a stream's start may take before its data: beyond, it is not one (a stream is refused). */
+const MAX_WAV_HEADER = 65536;
+
+/**
+ * Turns pieces into samples, keeping a byte that a piece of 16-bit PCM ended on for the next piece. Bytes that begin
+ * with a WAV header (as some services send their "PCM": Google's LINEAR16, OpenAI's `wav`) have it read and skipped,
+ * not played as samples (a click): it must say mono 16-bit PCM at `sampleRate` (where given), else a RangeError says
+ * what it is.
+ */
 export class PcmReader {
   private odd: number | null = null; // the first byte of a sample split between two pieces
+  private head: Uint8Array | null = new Uint8Array(0); // the stream's first bytes while they may be a WAV header; null after
 
-  constructor(private readonly where: string) {}
+  constructor(private readonly where: string, private readonly sampleRate?: number) {}
 
   /** The piece as float samples (a new array); throws a TypeError or RangeError that says what was wrong. */
   read(chunk: unknown): Float32Array {
+    if (chunk instanceof Float32Array || chunk instanceof Int16Array) this.head = null; // samples: no header to come
     if (chunk instanceof Float32Array) return finite(chunk.slice(), this.where);
     if (chunk instanceof Int16Array) return fromInt16(chunk);
     if (chunk instanceof ArrayBuffer || (typeof SharedArrayBuffer !== 'undefined' && chunk instanceof SharedArrayBuffer)) return this.bytes(new Uint8Array(chunk));
@@ -29,6 +39,17 @@ export class PcmReader {
 
   /** Bytes of 16-bit little-endian PCM; a byte left over waits for the next piece. */
   private bytes(piece: Uint8Array): Float32Array {
+    if (this.head) {
+      const start = new Uint8Array(this.head.length + piece.length);
+      start.set(this.head);
+      start.set(piece, this.head.length);
+      const found = wavData(start);
+      if (found === 'more' && start.length > MAX_WAV_HEADER) throw new RangeError(`${this.where}: the stream begins as a WAV file but has no data chunk in its first ${MAX_WAV_HEADER} bytes`);
+      this.head = found === 'more' ? start : null;
+      if (found === 'more') return new Float32Array(0); // the rest of the header is still to come
+      if (found) this.check(found.format);
+      piece = start.subarray(found ? found.data : 0);
+    }
     let bytes = piece;
     if (this.odd !== null) {
       bytes = new Uint8Array(piece.length + 1);
@@ -44,9 +65,45 @@ export class PcmReader {
     return out;
   }
 
+  /** A WAV header's format: mono 16-bit PCM at the stream's rate, else a RangeError saying what it is. */
+  private check(f: WavFormat): void {
+    const pcm = f.tag === 1 && f.bits === 16 && f.channels === 1;
+    if (pcm && (this.sampleRate === undefined || f.rate === this.sampleRate)) return;
+    const what = !f.channels ? 'with no format (fmt) chunk before its data' : `${f.channels === 1 ? 'mono' : `${f.channels} channels`}, ${f.bits}-bit ${f.tag === 3 ? 'float' : f.tag === 1 ? 'PCM' : `format ${f.tag}`}, ${f.rate} Hz`;
+    throw new RangeError(`${this.where}: the stream is a WAV file ${f.channels ? `(${what})` : what}; it takes mono 16-bit PCM at the stream's sampleRate`
+      + `${this.sampleRate ? ` (${this.sampleRate} Hz)` : ''}: ask the service for that, or open the stream with its rate`);
+  }
+
   /** Whether a byte is waiting for its pair (a stream ended on it is one byte short). */
   get pending(): boolean {
     return this.odd !== null;
+  }
+}
+
+interface WavFormat { tag: number; channels: number; rate: number; bits: number }
+
+const ascii = (b: Uint8Array, at: number) => String.fromCharCode(b[at], b[at + 1], b[at + 2], b[at + 3]);
+
+/**
+ * Where a WAV header at the start of `b` ends (its data chunk's first byte) and the format it states; 'more' while
+ * the bytes so far may still be one; null where they are not one (raw PCM).
+ */
+function wavData(b: Uint8Array): { data: number; format: WavFormat } | 'more' | null {
+  const riff = [0x52, 0x49, 0x46, 0x46]; // "RIFF"
+  if (b.length < 12) return riff.every((c, i) => i >= b.length || b[i] === c) ? 'more' : null;
+  if (ascii(b, 0) !== 'RIFF' || ascii(b, 8) !== 'WAVE') return null;
+  const v = new DataView(b.buffer, b.byteOffset, b.byteLength);
+  let format: WavFormat | null = null;
+  for (let at = 12; ; ) {
+    if (at + 8 > b.length) return 'more';
+    const size = v.getUint32(at + 4, true);
+    if (ascii(b, at) === 'data') return { data: at + 8, format: format ?? { tag: 0, channels: 0, rate: 0, bits: 0 } }; // (none: refused)
+    if (ascii(b, at) === 'fmt ') {
+      if (at + 24 > b.length) return 'more';
+      const tag = v.getUint16(at + 8, true);
+      format = { tag: tag === 0xfffe && at + 34 <= b.length ? v.getUint16(at + 32, true) : tag, channels: v.getUint16(at + 10, true), rate: v.getUint32(at + 12, true), bits: v.getUint16(at + 22, true) };
+    }
+    at += 8 + size + (size % 2);
   }
 }
 

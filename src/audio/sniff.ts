@@ -70,10 +70,14 @@ function wavReason(v: DataView): string {
   return `it is a WAV file (format ${tag}, ${bits}-bit) that this browser cannot decode: ${CONVERT}`;
 }
 
+/** A WAV data size from here up means "not known when written" (sox's 0x7FFFF000 to a pipe; 0xFFFFFFFF), not a length. */
+const OPEN_SIZE = 0x7ffff000;
+
 /**
  * How many seconds a WAV's header says its data chunk holds, where that is more than the file holds (a file cut
  * short while copying or recording: browsers decode what is there and say nothing); null otherwise, and for other
- * formats and for a data size left open (0 or 0xFFFFFFFF, as recorders that stream write it).
+ * formats and for a data size left open (0, 0xFFFFFFFF, or sox's 0x7FFFF000 when it writes to a pipe, as recorders
+ * that stream write it).
  */
 export function statedSecondsIfCut(bytes: ArrayBuffer): number | null {
   const v = new DataView(bytes);
@@ -85,7 +89,7 @@ export function statedSecondsIfCut(bytes: ArrayBuffer): number | null {
     if (id === 'fmt ' && at + 20 <= v.byteLength) byteRate = v.getUint32(at + 16, true);
     if (id === 'data') {
       const present = v.byteLength - at - 8;
-      if (size === 0 || size >= 0xffffff00 || size <= present || !byteRate) return null;
+      if (size === 0 || size >= OPEN_SIZE || size <= present || !byteRate) return null;
       return size / byteRate;
     }
     at += 8 + size + (size % 2);

@@ -31,7 +31,7 @@ export class SpeechStream {
   readonly sampleRate: number;
   /** The whole speech once it has played out (not for a MediaStream's); null until then. */
   take: StreamTake | null = null;
-  private readonly reader = new PcmReader('SpeechStream.write');
+  private readonly reader: PcmReader;
   private pieces: Float32Array[] = [];
   private pending: Float32Array[] = []; // written before the model and the face were there
   private written = 0; // samples written, at sampleRate
@@ -52,6 +52,7 @@ export class SpeechStream {
   /** `options` as checkedStreamOptions gives them. */
   constructor(options: ReturnType<typeof checkedStreamOptions>, private readonly host: StreamHost) {
     this.sampleRate = options.sampleRate;
+    this.reader = new PcmReader('SpeechStream.write', this.sampleRate);
     if (options.media) this.media = { stream: options.media, follower: null };
     this.delayMs0 = options.delayMs;
     this.done = new Promise((resolve, reject) => (this.settle = { resolve, reject }));

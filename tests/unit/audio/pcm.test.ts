@@ -40,6 +40,42 @@ describe('PcmReader', () => {
     expect(r.pending).toBe(true); // a stream that ended here is one byte short
   });
 
+  /** A WAV header (fmt with `tag`, `channels`, `rate`, `bits`; a LIST chunk before it) and then `samples` 16-bit samples. */
+  const wavStream = (samples: number[], { tag = 1, channels = 1, rate = 24000, bits = 16 } = {}) => {
+    const head = new DataView(new ArrayBuffer(12 + 8 + 6 + 8 + 16 + 8));
+    const put = (at: number, text: string) => [...text].forEach((c, i) => head.setUint8(at + i, c.charCodeAt(0)));
+    put(0, 'RIFF'); head.setUint32(4, 0xffffffff, true); put(8, 'WAVE'); // (a stream's size: not known)
+    put(12, 'LIST'); head.setUint32(16, 5, true); // odd: padded to 6
+    put(26, 'fmt '); head.setUint32(30, 16, true);
+    head.setUint16(34, tag, true); head.setUint16(36, channels, true); head.setUint32(38, rate, true); head.setUint16(48, bits, true);
+    put(50, 'data'); head.setUint32(54, 0xffffffff, true);
+    const out = new Uint8Array(head.byteLength + 2 * samples.length);
+    out.set(new Uint8Array(head.buffer));
+    samples.forEach((v, i) => new DataView(out.buffer).setInt16(head.byteLength + 2 * i, v, true));
+    return out;
+  };
+
+  it('skips a WAV header at the stream\'s start (as some services send their PCM), in one piece or split, not playing it', () => {
+    const bytes = wavStream([16384, -16384, 8192]);
+    expect(Array.from(new PcmReader('write', 24000).read(bytes))).toEqual([0.5, -0.5, 0.25]);
+    for (const cut of [3, 11, 30, 55, 59]) { // within "RIFF", before "WAVE", inside fmt, inside the data chunk's header, inside the first sample
+      const r = new PcmReader('write', 24000);
+      const got = [...r.read(bytes.subarray(0, cut)), ...r.read(bytes.subarray(cut))];
+      expect(got, `split at ${cut}`).toEqual([0.5, -0.5, 0.25]);
+    }
+    const raw = Uint8Array.of(0x00, 0x40, 0x52, 0x49); // raw PCM (even one whose later bytes spell "RI")
+    expect(Array.from(new PcmReader('write').read(raw))).toEqual([0.5, 0x4952 / 32768]);
+    const r = new PcmReader('write');
+    r.read(Uint8Array.of(0x00, 0x40));
+    expect(Array.from(r.read(wavStream([16384]).subarray(0, 12))).length, 'only the start of a stream is a header').toBe(6);
+  });
+
+  it('refuses a WAV header that is not mono 16-bit PCM at the stream\'s rate, saying what it is', () => {
+    expect(() => new PcmReader('write', 16000).read(wavStream([1]))).toThrow(/write: the stream is a WAV file \(mono, 16-bit PCM, 24000 Hz\); it takes mono 16-bit PCM at the stream's sampleRate \(16000 Hz\)/);
+    expect(() => new PcmReader('write', 24000).read(wavStream([1], { channels: 2 }))).toThrow(/\(2 channels, 16-bit PCM, 24000 Hz\)/);
+    expect(() => new PcmReader('write', 24000).read(wavStream([1], { tag: 3, bits: 32 }))).toThrow(/\(mono, 32-bit float, 24000 Hz\)/);
+  });
+
   it('says what it takes when given something else, and refuses samples that are not finite', () => {
     const r = new PcmReader('SpeechStream.write');
     expect(() => r.read('UklGRg==')).toThrow(/SpeechStream\.write takes a Float32Array .* given a string \(base64 text\? decode it to bytes first\)/);

@@ -84,6 +84,7 @@ describe('statedSecondsIfCut', () => {
     expect(statedSecondsIfCut(pcm(8000, 8000))).toBeNull();
     expect(statedSecondsIfCut(pcm(8000, 0))).toBeNull(); // a recorder streaming: size not yet written
     expect(statedSecondsIfCut(pcm(8000, 0xffffffff))).toBeNull();
+    expect(statedSecondsIfCut(pcm(8000, 0x7ffff000))).toBeNull(); // sox writing to a pipe (it cannot seek back)
     expect(statedSecondsIfCut(bytes(0x49, 0x44, 0x33, 0x04))).toBeNull();
     expect(statedSecondsIfCut(new ArrayBuffer(4))).toBeNull();
   });
