@@ -10,7 +10,7 @@
  * Nothing here assumes a vertex count: a FLAME head (5023 vertices) converted
  * with `scripts/import-template.ts` loads through the same code.
  */
-import { buildAdjacency, type Adjacency } from './mesh-topology';
+import { boundaryLoops, buildAdjacency, type Adjacency } from './mesh-topology';
 import { fetchBody } from '../model/fetch-body';
 
 export const TEMPLATE_FORMAT = 'talking-face-template';
@@ -163,6 +163,7 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
     throw new TemplateFormatError(`template "${h.id}": buffer sizes do not match vertexCount ${n}`);
   }
   checkIndices(triangles, n, 'triangles');
+  checkMesh(`template "${h.id}"`, h.units, positions, triangles);
   checkIndices(indices, n, 'adjacencyIndices');
   const regions = {} as Regions;
   for (const [name, list] of Object.entries(h.regions)) {
@@ -222,6 +223,7 @@ export function templateFromMesh(
 ): FaceTemplate {
   const n = positions.length / 3;
   checkIndices(triangles, n, 'triangles');
+  checkMesh(source.file ?? `template "${id}"`, units, positions, triangles);
   const r = {} as Regions;
   for (const [name, list] of Object.entries(regions)) {
     const idx = Uint32Array.from(list);
@@ -229,6 +231,23 @@ export function templateFromMesh(
     r[name] = idx;
   }
   return { id, units, vertexCount: n, positions, uvs, triangles, adjacency: buildAdjacency(n, triangles), regions: r, source };
+}
+
+/**
+ * What the face's renderer needs of a mesh, said before it is drawn (else the head could not be built): known units,
+ * finite coordinates, triangles, and edges on the mesh's boundary (the eyes' and mouth's openings, the outline) that
+ * form loops: a triangle wound the other way from its neighbours, or two openings meeting at one vertex, do not.
+ */
+function checkMesh(what: string, units: unknown, positions: Float32Array, triangles: Uint32Array): void {
+  if (!Object.hasOwn(MM_PER_UNIT, units as string)) throw new TemplateFormatError(`${what}: units must be one of ${Object.keys(MM_PER_UNIT).join(', ')}, not ${JSON.stringify(units)}`);
+  const bad = positions.findIndex((x) => !Number.isFinite(x));
+  if (bad >= 0) throw new TemplateFormatError(`${what}: vertex ${Math.floor(bad / 3)} has a coordinate that is not a number (${positions[bad]})`);
+  if (triangles.length === 0 || triangles.length % 3) throw new TemplateFormatError(`${what}: it has ${triangles.length ? 'a broken triangle list' : 'no triangles'}`);
+  try {
+    boundaryLoops(triangles);
+  } catch (e) {
+    throw new TemplateFormatError(`${what}: its boundary does not form loops (${(e as Error).message}); a triangle wound the other way from its neighbours, or two openings meeting at one vertex, does this: fix it in a mesh editor`);
+  }
 }
 
 function checkIndices(a: Uint32Array, n: number, what: string): void {

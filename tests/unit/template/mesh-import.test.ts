@@ -82,3 +82,24 @@ describe('PLY import', () => {
     expect(() => templateFromUserMesh('x', 'x.stl', enc(''), masks)).toThrow(/must be .obj or .ply/);
   });
 });
+
+describe('a mesh the face cannot be drawn from is refused at import, naming the file', () => {
+  const plyOf = (positions: string[], faces: number[][]) => enc(
+    `ply\nformat ascii 1.0\nelement vertex ${positions.length}\nproperty float x\nproperty float y\nproperty float z\n` +
+    `element face ${faces.length}\nproperty list uchar int vertex_indices\nend_header\n${positions.join('\n')}\n${faces.map((f) => `${f.length} ${f.join(' ')}`).join('\n')}\n`);
+  const g = grid();
+  const vertices = Array.from({ length: 9 }, (_, v) => g.positions.slice(3 * v, 3 * v + 3).join(' '));
+  const faces = Array.from({ length: 8 }, (_, t) => g.triangles.slice(3 * t, 3 * t + 3));
+
+  it('a coordinate that is not a number, no faces, or units it does not know', () => {
+    expect(() => templateFromUserMesh('g', 'nan.ply', plyOf(['nan 0 0', ...vertices.slice(1)], faces), masks)).toThrow(/nan\.ply: vertex 0 has a coordinate that is not a number \(NaN\)/);
+    expect(() => templateFromUserMesh('g', 'empty.ply', plyOf(vertices, []), masks)).toThrow(/empty\.ply: it has no triangles/);
+    expect(() => templateFromUserMesh('g', 'g.ply', plyOf(vertices, faces), { ...masks, units: 'MM' as 'mm' })).toThrow(/g\.ply: units must be one of mm, cm, m, not "MM"/);
+  });
+
+  it('a triangle wound the other way from its neighbours (its boundary forms no loops)', () => {
+    const flipped = faces.map((f, t) => (t === 0 ? [f[0], f[2], f[1]] : f));
+    expect(() => templateFromUserMesh('g', 'flipped.ply', plyOf(vertices, flipped), masks)).toThrow(/flipped\.ply: its boundary does not form loops .* fix it in a mesh editor/);
+    expect(templateFromUserMesh('g', 'g.ply', plyOf(vertices, faces), masks).vertexCount).toBe(9); // as it was: taken
+  });
+});
