@@ -12,6 +12,9 @@ export interface Tensor {
   data: TensorData;
 }
 
+/** Bytes per value of each dtype read here. */
+const ELEMENT_BYTES: Record<string, number> = { F32: 4, I32: 4, I64: 8, U32: 4 };
+
 export class SafetensorsError extends Error {
   override name = 'SafetensorsError';
 }
@@ -36,16 +39,21 @@ export function parseSafetensors(buffer: ArrayBuffer): { tensors: Map<string, Te
       continue;
     }
     const { dtype, shape, data_offsets } = spec as { dtype: string; shape: number[]; data_offsets: [number, number] };
-    const [a, b] = data_offsets;
-    if (base + b > buffer.byteLength || a > b) throw new SafetensorsError(`tensor ${name} lies outside the file`);
+    const size = Object.hasOwn(ELEMENT_BYTES, dtype) ? ELEMENT_BYTES[dtype] : 0;
+    if (!size) throw new SafetensorsError(`tensor ${name}: dtype ${dtype} is not supported`);
+    if (!Array.isArray(shape) || !shape.every((d) => Number.isInteger(d) && d >= 0)) throw new SafetensorsError(`tensor ${name}: its shape ${JSON.stringify(shape)} is not a list of sizes`);
+    const [a, b] = Array.isArray(data_offsets) ? data_offsets : [NaN, NaN];
+    if (!Number.isInteger(a) || !Number.isInteger(b) || a < 0 || a > b || base + b > buffer.byteLength) {
+      throw new SafetensorsError(`tensor ${name} lies outside the file (data_offsets ${JSON.stringify(data_offsets)}): file truncated or damaged`);
+    }
+    if ((b - a) % size) throw new SafetensorsError(`tensor ${name}: ${b - a} bytes is not a whole number of ${dtype} values`);
     const bytes = buffer.slice(base + a, base + b);
     const count = shape.reduce((x, y) => x * y, 1);
     let data: TensorData;
     if (dtype === 'F32') data = new Float32Array(bytes);
     else if (dtype === 'I32') data = new Int32Array(bytes);
     else if (dtype === 'I64') data = new BigInt64Array(bytes);
-    else if (dtype === 'U32') data = new Uint32Array(bytes);
-    else throw new SafetensorsError(`tensor ${name}: dtype ${dtype} is not supported`);
+    else data = new Uint32Array(bytes);
     if (data.length !== count) throw new SafetensorsError(`tensor ${name}: ${data.length} values for shape [${shape}]`);
     tensors.set(name, { dtype: dtype as Tensor['dtype'], shape, data });
   }
