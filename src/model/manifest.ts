@@ -61,6 +61,9 @@ export interface Manifest {
   content_phones: string[];
 }
 
+/** What the browser loads of every model: the four ONNX encoders and the decoder's weights. */
+const RUNTIME_KEYS = ['content_encoder', 'hierarchical', 'pose_conv', 'pose_lstm', 'decoder_weights'];
+
 export class ManifestError extends Error {
   override name = 'ManifestError';
 }
@@ -72,9 +75,15 @@ export function checkManifest(m: unknown): Manifest {
     throw new ManifestError(`model manifest version ${x.version} is not supported by this build (${MANIFEST_VERSION}): `
       + 're-export the model with this build\'s exporter');
   }
-  for (const key of ['sample_rate', 'frame_size', 'hop', 'n_mels', 'fps'] as const) {
+  for (const key of ['sample_rate', 'frame_size', 'hop', 'n_mels', 'fps', 'feature_rate'] as const) {
     if (!Number.isFinite(x.audio?.[key])) throw new ManifestError(`model manifest lacks audio.${key}`);
   }
+  for (const key of ['d_model', 'heads', 'layers', 'ffn', 'content_classes', 'window', 'window_future', 'content_stride', 'pose_channels'] as const) {
+    if (!Number.isInteger(x.model?.config?.[key])) throw new ManifestError(`model manifest lacks model.config.${key} (re-export the model)`);
+  }
+  // The files the browser loads: each named, with its digest (a missing one is no "corrupt" download, nor a TypeError).
+  const missing = RUNTIME_KEYS.filter((k) => !x.runtime_files?.includes(k) || typeof x.files?.[k] !== 'string' || typeof x.sha256?.[k] !== 'string');
+  if (missing.length) throw new ManifestError(`model manifest lacks ${missing.join(', ')} in runtime_files, files or sha256 (re-export the model)`);
   if (!Array.isArray(x.content_phones) || x.content_phones.length !== x.model?.config?.content_classes) {
     throw new ManifestError('model manifest lacks content_phones, one name per content class (re-export the model)');
   }

@@ -35,6 +35,22 @@ describe('fetchArtefacts', () => {
     expect(() => checkManifest({ ...manifest, version: 1 })).toThrow(/version 1 is not supported by this build \(2\): re-export/);
   });
 
+  it('refuses a manifest that lacks what the browser loads, saying what (not "corrupt", nor a TypeError later)', () => {
+    const manifest = JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8'));
+    const without = (path: string[]) => {
+      const m = structuredClone(manifest);
+      let at = m;
+      for (const key of path.slice(0, -1)) at = at[key];
+      delete at[path.at(-1)!];
+      return m;
+    };
+    expect(() => checkManifest(without(['sha256', 'pose_lstm']))).toThrow(/lacks pose_lstm in runtime_files, files or sha256/);
+    expect(() => checkManifest(without(['files', 'decoder_weights']))).toThrow(/lacks decoder_weights in runtime_files, files or sha256/);
+    expect(() => checkManifest(without(['runtime_files']))).toThrow(/lacks content_encoder, hierarchical, pose_conv, pose_lstm, decoder_weights in runtime_files/);
+    expect(() => checkManifest(without(['audio', 'feature_rate']))).toThrow(/lacks audio\.feature_rate/);
+    expect(() => checkManifest(without(['model', 'config', 'window']))).toThrow(/lacks model\.config\.window/);
+  });
+
   it('rejects only the corrupt file, with a message that names it', async () => {
     const manifest = JSON.parse(readFileSync(resolve(MODELS, 'manifest.json'), 'utf8'));
     const a = await fetchArtefacts({ manifestUrl, fetch: diskFetch([manifest.files.hierarchical]) });
