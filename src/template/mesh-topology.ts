@@ -77,7 +77,7 @@ export function boundaryLoops(triangles: Uint32Array): number[][] {
   return loops;
 }
 
-/** Split an undirected edge list into its connected chains/cycles, each as an ordered vertex list. */
+/** Split an undirected edge list into its connected chains/cycles, each as an ordered vertex list (a chain from one end). */
 export function edgeCycles(edges: ReadonlyArray<readonly [number, number]>): number[][] {
   const nbr = new Map<number, number[]>();
   for (const [a, b] of edges) {
@@ -86,7 +86,8 @@ export function edgeCycles(edges: ReadonlyArray<readonly [number, number]>): num
   }
   const seen = new Set<number>();
   const cycles: number[][] = [];
-  for (const start of nbr.keys()) {
+  const ends = [...nbr.keys()].filter((v) => nbr.get(v)!.length === 1); // a chain walked from the middle would split in two
+  for (const start of [...ends, ...nbr.keys()]) {
     if (seen.has(start)) continue;
     const cycle = [start];
     seen.add(start);

@@ -2,7 +2,7 @@ import { describe, expect, it, beforeAll } from 'vitest';
 import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { decodeTemplate, encodeTemplate, REQUIRED_REGIONS, TemplateFormatError, type FaceTemplate, type TemplateHeader } from '../../../src/template/face-template';
-import { boundaryLoops, buildAdjacency, neighbours } from '../../../src/template/mesh-topology';
+import { boundaryLoops, buildAdjacency, edgeCycles, neighbours } from '../../../src/template/mesh-topology';
 import { extractMediapipeTemplate } from '../../../scripts/extract-template';
 import { formatJson } from '../../../scripts/format-json';
 
@@ -115,5 +115,13 @@ describe('template decoding rejects broken files with a clear error', () => {
     const again = await decodeTemplate(JSON.parse(JSON.stringify(header)), binary.buffer as ArrayBuffer);
     expect(Array.from(again.positions)).toEqual(Array.from(t.positions));
     expect(Array.from(again.regions.jaw)).toEqual(Array.from(t.regions.jaw));
+  });
+});
+
+describe('edgeCycles', () => {
+  it('walks a closed loop round, and an open chain from one end whatever order its edges come in', () => {
+    expect(edgeCycles([[0, 1], [1, 2], [2, 0]])).toEqual([[0, 1, 2]]);
+    expect(edgeCycles([[2, 3], [1, 2]])).toEqual([[3, 2, 1]]); // (from its middle it came out as [2, 3] and [1])
+    expect(edgeCycles([[5, 6], [7, 8], [6, 7]]).map((c) => c.length)).toEqual([4]);
   });
 });
