@@ -43,6 +43,7 @@ export default defineConfig({
   timeout: 60_000,
   expect: { timeout: 20_000 },
   fullyParallel: false,
+  forbidOnly: true, // a test.only left in would run alone and report success
   workers: 1,
   retries: 0,
   reporter: process.env.CI ? [['list']] : [['list']],
@@ -59,7 +60,7 @@ export default defineConfig({
   webServer: {
     command: `npm run --silent build:test && npx vite preview --host 127.0.0.1 --port ${PORT} --strictPort`,
     url: `http://127.0.0.1:${PORT}/`,
-    timeout: 120_000,
+    timeout: 300_000, // (it builds first: on a fresh clone, with nothing yet compressed, more than two minutes on a slow runner)
     reuseExistingServer: false,
   },
 });

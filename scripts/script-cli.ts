@@ -67,6 +67,21 @@ export function startServer(command: string, args: string[], cwd: string): Serve
   child.stdout.on('data', keep);
   child.stderr.on('data', keep);
   const exited = () => child.exitCode ?? child.signalCode;
+  const stop = (): void => {
+    try {
+      process.kill(-child.pid!);
+    } catch {
+      /* already gone */
+    }
+  };
+  // Its own process group (detached): Ctrl-C reaches only the script, whose `finally` then does not run. Stopped here
+  // instead, or it would hold its port for the next run.
+  for (const signal of ['SIGINT', 'SIGTERM'] as const) {
+    process.once(signal, () => {
+      stop();
+      process.exit(128 + (signal === 'SIGINT' ? 2 : 15));
+    });
+  }
   return {
     async ready(url: string, seconds = 60): Promise<void> {
       const deadline = Date.now() + seconds * 1000;
@@ -82,12 +97,6 @@ export function startServer(command: string, args: string[], cwd: string): Serve
         if (Date.now() > deadline) throw new Error(`${url} did not answer within ${seconds} s (last: ${last})${output ? `:\n${output.trim()}` : ''}`);
       }
     },
-    stop(): void {
-      try {
-        process.kill(-child.pid!);
-      } catch {
-        /* already gone */
-      }
-    },
+    stop,
   };
 }

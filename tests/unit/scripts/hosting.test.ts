@@ -1,6 +1,6 @@
 /** How the build is served (scripts/hosting.ts): cache headers by path, precompressed copies, ETags, 404s. */
 import { createServer, request, type IncomingHttpHeaders, type Server } from 'node:http';
-import { mkdtempSync, mkdirSync, writeFileSync, existsSync, utimesSync } from 'node:fs';
+import { mkdtempSync, mkdirSync, rmSync, writeFileSync, existsSync, utimesSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
@@ -47,7 +47,10 @@ describe('serveBuild', () => {
     const a = server.address();
     base = `http://127.0.0.1:${typeof a === 'object' && a ? a.port : 0}`;
   });
-  afterAll(() => server.close());
+  afterAll(() => {
+    server.close();
+    rmSync(root, { recursive: true, force: true });
+  });
 
   it('writes .br and .gz beside what compresses', () => {
     expect(existsSync(join(root, 'assets/app-abcdEF12.js.br'))).toBe(true);
