@@ -9,6 +9,7 @@ import torch
 
 from talkingface import export
 from talkingface.artefacts import compare_exports
+from talkingface.cli import read_checkpoint
 from talkingface.paths import MODELS_DIR
 from talkingface.safetensors import read_safetensors, sha256
 from talkingface.train import train
@@ -101,6 +102,37 @@ def test_an_export_refuses_a_folder_holding_another_face(trained_run, tmp_path):
     (tmp_path / "template" / "template.json").write_text(json.dumps({"id": "someone-else"}))
     with pytest.raises(ValueError, match="someone-else"):
         export.export(trained_run / "final.pt", tmp_path)
+
+
+def test_a_template_that_is_not_the_models_is_named_as_such(corpus, trained_run, tmp_path):
+    """--template B for a model trained on A, into a folder holding A: B is the wrong one (not the folder's A)."""
+    (tmp_path / "template").mkdir()
+    (tmp_path / "template" / "template.json").write_text(json.dumps({"id": corpus.template.id}))
+    other = dataclasses.replace(corpus.template, id="someone-else")
+    with pytest.raises(ValueError, match=f"trained on template {corpus.template.id}, not someone-else"):
+        export.export(trained_run / "final.pt", tmp_path, other)
+
+
+def test_the_export_fails_where_the_browser_would_have_no_face_to_load(trained_run, tmp_path, monkeypatch, capsys):
+    """A template the exporter cannot copy (a mesh: it has no template.json) leaves the export without its face: exit 1."""
+    monkeypatch.setattr(export, "copy_template", lambda source, out: f"note: {out}/template/template.json is missing")
+    assert export.main(["--checkpoint", str(trained_run / "final.pt"), "--out", str(tmp_path)]) == 1
+    assert "the browser cannot load it without its face template" in capsys.readouterr().err
+
+
+def test_an_export_that_fails_leaves_its_folder_as_it_was(exported, trained_run):
+    """A checkpoint that fails once the ONNX files are made (here: it has no step count) changes nothing in `out`:
+    the browser still loads the export that was there, not new ONNX files beside the old manifest."""
+    out, _, _ = exported
+    files = lambda: {p.relative_to(out): sha256(p) for p in sorted(out.rglob("*")) if p.is_file()}  # noqa: E731
+    before = files()
+    ck = read_checkpoint(trained_run / "final.pt")
+    ck["model"] = {k: v + 0.5 if v.is_floating_point() else v for k, v in ck["model"].items()}  # other weights: other ONNX bytes
+    del ck["step"]
+    with pytest.raises(KeyError, match="step"):
+        export.export(trained_run / "final.pt", out, ck=ck)
+    assert files() == before
+    assert not [p.name for p in out.iterdir() if p.name.startswith(".export-")], "the staging folder is removed"
 
 
 def test_committed_models_are_what_the_exporter_writes(reexported):

@@ -21,3 +21,34 @@ def test_wav_round_trip_and_stereo(tmp_path):
     (tmp_path / "bad.wav").write_bytes(b"not a wav at all")
     with pytest.raises(WavError, match="not a WAV"):
         read_wav(tmp_path / "bad.wav")
+
+
+def _wav(fmt: bytes, data: bytes) -> bytes:
+    chunks = b"fmt " + len(fmt).to_bytes(4, "little") + fmt + b"data" + len(data).to_bytes(4, "little") + data
+    return b"RIFF" + (4 + len(chunks)).to_bytes(4, "little") + b"WAVE" + chunks
+
+
+def _extensible(sub: int, bits: int, channels: int = 1, rate: int = 16000) -> bytes:
+    """WAVE_FORMAT_EXTENSIBLE's fmt chunk (as ffmpeg writes beyond 16 bits): the format is its sub-format GUID's first two bytes."""
+    block = channels * bits // 8
+    return (0xFFFE.to_bytes(2, "little") + channels.to_bytes(2, "little") + rate.to_bytes(4, "little") + (rate * block).to_bytes(4, "little")
+            + block.to_bytes(2, "little") + bits.to_bytes(2, "little") + (22).to_bytes(2, "little") + bits.to_bytes(2, "little")
+            + (4).to_bytes(4, "little") + sub.to_bytes(2, "little") + bytes.fromhex("000000001000800000aa00389b71"))
+
+
+def test_extensible_wav_is_read_by_its_sub_format(tmp_path):
+    floats = np.array([0.25, -0.5, 0.75], "<f4")
+    (tmp_path / "f.wav").write_bytes(_wav(_extensible(3, 32), floats.tobytes()))
+    y, sr = read_wav(tmp_path / "f.wav")
+    assert sr == 16000 and np.allclose(y, floats)
+    (tmp_path / "p.wav").write_bytes(_wav(_extensible(1, 16), np.array([16384], "<i2").tobytes()))
+    assert np.allclose(read_wav(tmp_path / "p.wav")[0], [0.5])
+    (tmp_path / "law.wav").write_bytes(_wav(_extensible(7, 16), bytes(4)))  # mu-law, said to be 16-bit: not PCM
+    with pytest.raises(WavError, match="encoding 7 with 16 bits is not supported"):
+        read_wav(tmp_path / "law.wav")
+
+
+def test_a_damaged_fmt_chunk_is_said_not_divided_by(tmp_path):
+    (tmp_path / "z.wav").write_bytes(_wav(_extensible(1, 16, channels=0), bytes(4)))
+    with pytest.raises(WavError, match=r"fmt chunk is damaged \(0 channels"):
+        wav_seconds(tmp_path / "z.wav")

@@ -20,6 +20,7 @@ import torch
 
 from .data.datasets import DatasetError
 from .template import TemplateFormatError
+from .wav import WavError
 
 
 class CheckpointError(ValueError):
@@ -51,7 +52,7 @@ def run_cli(main: Callable[[], int | None]) -> None:
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         sys.exit(130)
-    except (CheckpointError, DatasetError, TemplateFormatError, FileNotFoundError, FileExistsError, NotADirectoryError,
+    except (CheckpointError, DatasetError, TemplateFormatError, WavError, FileNotFoundError, FileExistsError, NotADirectoryError,
             IsADirectoryError, PermissionError) as e:
         if os.environ.get("TALKING_FACE_TRACEBACK"):
             traceback.print_exc()

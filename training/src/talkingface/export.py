@@ -22,7 +22,9 @@ from __future__ import annotations
 import argparse
 import io
 import json
+import os
 import shutil
+import tempfile
 import sys
 import warnings
 from pathlib import Path
@@ -187,35 +189,54 @@ def copy_template(source: Path | None, out: Path) -> str | None:
 
 def export(checkpoint: Path, out: Path, template: Template | None = None, ck: dict | None = None) -> dict:
     """Write the browser's files for `checkpoint` into `out`; `template` defaults to the one the checkpoint names;
-    `ck`: the checkpoint already read (read_checkpoint), so that it is read once."""
+    `ck`: the checkpoint already read (read_checkpoint), so that it is read once. Everything is written into a folder
+    inside `out` first and moved into place once all of it is made: an export that fails (a checkpoint of a decoder
+    the browser does not run, a missing key, Ctrl-C) leaves `out` as it was, not its ONNX files replaced beside the
+    old manifest (which the browser would then refuse as corrupt)."""
+    out.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".export-", dir=out))
+    try:
+        manifest = _export_into(stage, checkpoint, out, template, ck)
+        for made in sorted(p for p in stage.rglob("*") if p.is_file()):
+            there = out / made.relative_to(stage)
+            there.parent.mkdir(parents=True, exist_ok=True)
+            if made.name != "manifest.json":
+                os.replace(made, there)
+        os.replace(stage / "manifest.json", out / "manifest.json")  # last: it names what is now there
+        return manifest
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _export_into(stage: Path, checkpoint: Path, out: Path, template: Template | None, ck: dict | None) -> dict:
+    """export()'s work, every file written into `stage` (moved to `out` by export)."""
     from .train.train import checkpoint_template, model_of
     ck = read_checkpoint(checkpoint) if ck is None else ck
     if template is None:
         template = checkpoint_template(ck)
+    model, ck = model_of(ck, template, checkpoint)  # (first: a --template that is not the model's is named as such)
     check_out_template(out, template)
-    model, ck = model_of(ck, template, checkpoint)
     model.eval()
     cfg, a = model.cfg, model.audio
-    out.mkdir(parents=True, exist_ok=True)
     files = {}
 
     K = 120
     mel = torch.randn(1, K, a.n_mels)
-    _onnx(model.content, (mel,), out / "content_encoder.onnx", ["mel"], ["logits"], {"mel": {1: "K"}, "logits": {1: "Kc"}})
+    _onnx(model.content, (mel,), stage / "content_encoder.onnx", ["mel"], ["logits"], {"mel": {1: "K"}, "logits": {1: "Kc"}})
     files["content_encoder"] = "content_encoder.onnx"
     win = torch.rand(3, cfg.window, cfg.content_classes)
-    _onnx(_HierarchicalLatents(model), (win,), out / "hierarchical.onnx", ["windows"], ["latents"], {"windows": {0: "F"}, "latents": {0: "F"}})
+    _onnx(_HierarchicalLatents(model), (win,), stage / "hierarchical.onnx", ["windows"], ["latents"], {"windows": {0: "F"}, "latents": {0: "F"}})
     files["hierarchical"] = "hierarchical.onnx"
-    _onnx(_PoseConv(model.pose_encoder), (mel,), out / "pose_conv.onnx", ["mel"], ["conv"], {"mel": {1: "K"}, "conv": {1: "K"}})
+    _onnx(_PoseConv(model.pose_encoder), (mel,), stage / "pose_conv.onnx", ["mel"], ["conv"], {"mel": {1: "K"}, "conv": {1: "K"}})
     files["pose_conv"] = "pose_conv.onnx"
     C = cfg.pose_channels
-    _onnx(_PoseLSTM(model.pose_encoder), (torch.randn(1, K, C), torch.zeros(1, 1, C), torch.zeros(1, 1, C)), out / "pose_lstm.onnx",
+    _onnx(_PoseLSTM(model.pose_encoder), (torch.randn(1, K, C), torch.zeros(1, 1, C), torch.zeros(1, 1, C)), stage / "pose_lstm.onnx",
           ["conv", "h0", "c0"], ["pose_features", "hn", "cn"], {"conv": {1: "K"}, "pose_features": {1: "K"}})
     files["pose_lstm"] = "pose_lstm.onnx"
     T = 4
     mm_per_unit = template.to_millimetres()
     tpl = torch.from_numpy(template.vertices * mm_per_unit)[None]
-    _onnx(_Dense(model), (mel, torch.arange(10, 10 + 3 * T, 3)[None], tpl), out / "gava_dense.onnx",
+    _onnx(_Dense(model), (mel, torch.arange(10, 10 + 3 * T, 3)[None], tpl), stage / "gava_dense.onnx",
           ["mel", "mel_index", "template"], ["vertices", "offsets", "pose"],
           {"mel": {1: "K"}, "mel_index": {1: "T"}, "vertices": {1: "T"}, "offsets": {1: "T"}, "pose": {1: "T"}})
     files["dense_model"] = "gava_dense.onnx"
@@ -223,16 +244,16 @@ def export(checkpoint: Path, out: Path, template: Template | None = None, ck: di
     head = HeadMotion.from_dict(ck["head_motion"]) if "head_motion" in ck else None
     if head is not None:  # the head's own motion: read by src/pose/head-motion.ts from the same file
         weights |= {f"head_motion.{k}": np.asarray(v, np.float32) for k, v in head.to_dict().items()}
-    write_safetensors(out / "gava.safetensors", weights)
+    write_safetensors(stage / "gava.safetensors", weights)
     files["decoder_weights"] = "gava.safetensors"
 
     template_mm = (template.vertices * mm_per_unit).astype(np.float32)
     closure = ck.get("lip_closure")
     closer = LipClosure(template, template_mm, closure["reference_gap_mm"], closure.get("mouth_gain", 1.0)) if closure else None
-    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), out / "fixtures", head, closer)
+    fixtures = write_fixtures(model, template_mm, fixture_audio(a.sample_rate), stage / "fixtures", head, closer)
     if out.resolve() == MODELS_DIR.resolve() and checkpoint.resolve() != (out / "checkpoint.pt").resolve():
         slim = {k: v for k, v in ck.items() if k != "optimizer"}
-        torch.save(slim, out / "checkpoint.pt")
+        torch.save(slim, stage / "checkpoint.pt")
 
     all_files = {**files, "fixtures": fixtures["file"]}
     runtime = ["content_encoder", "hierarchical", "pose_conv", "pose_lstm", "decoder_weights"]
@@ -281,9 +302,9 @@ def export(checkpoint: Path, out: Path, template: Template | None = None, ck: di
         "look_ahead_ms": round(1000 * ((cfg.window_future * cfg.content_stride + receptive_field(model)["content_mel_frames"]) / a.feature_rate
                                        + a.frame_size / 2 / a.sample_rate)),
     }
-    manifest["sha256"] = {name: sha256(out / path) for name, path in all_files.items()}
-    manifest["runtime_bytes"] = sum((out / files[n]).stat().st_size for n in runtime)
-    (out / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
+    manifest["sha256"] = {name: sha256(stage / path) for name, path in all_files.items()}
+    manifest["runtime_bytes"] = sum((stage / files[n]).stat().st_size for n in runtime)
+    (stage / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
     return manifest
 
 
@@ -307,6 +328,9 @@ def main(argv=None) -> int:
     named = args.template or next((p for p in (recorded, REPO_ROOT / recorded) if str(recorded) and p.is_file()), TEMPLATE_DIR / "template.json")
     if said := copy_template(named, args.out):
         print(said, file=sys.stderr)
+    if not (args.out / "template" / "template.json").exists():
+        print(f"error: the model is exported to {args.out}, but the browser cannot load it without its face template there", file=sys.stderr)
+        return 1
     print(f"exported {m['model']['name']} ({m['model']['parameters']:,} parameters): runtime files {m['runtime_bytes'] / 1e6:.2f} MB -> {args.out}")
     return 0
 

@@ -21,7 +21,7 @@ class WavError(ValueError):
 
 @dataclass(frozen=True)
 class WavFormat:
-    code: int          # PCM, FLOAT or EXTENSIBLE
+    code: int          # PCM or FLOAT (EXTENSIBLE: its sub-format), or another the reader refuses
     channels: int
     sample_rate: int   # Hz
     bits: int          # per sample
@@ -39,8 +39,12 @@ def _chunks(path: Path) -> tuple[WavFormat, bytes]:
         cid, size = raw[pos : pos + 4], int.from_bytes(raw[pos + 4 : pos + 8], "little")
         body = raw[pos + 8 : pos + 8 + size]
         if cid == b"fmt ":
-            fmt = WavFormat(int.from_bytes(body[0:2], "little"), int.from_bytes(body[2:4], "little"),
-                            int.from_bytes(body[4:8], "little"), int.from_bytes(body[14:16], "little"))
+            code = int.from_bytes(body[0:2], "little")
+            if code == EXTENSIBLE and len(body) >= 26:  # its sub-format GUID begins with the code it stands for
+                code = int.from_bytes(body[24:26], "little")
+            fmt = WavFormat(code, int.from_bytes(body[2:4], "little"), int.from_bytes(body[4:8], "little"), int.from_bytes(body[14:16], "little"))
+            if fmt.channels < 1 or fmt.sample_rate < 1 or fmt.bits < 8 or fmt.bits % 8:
+                raise WavError(f"{path}: its fmt chunk is damaged ({fmt.channels} channels, {fmt.sample_rate} Hz, {fmt.bits} bits)")
         elif cid == b"data":
             data = body
         pos += 8 + size + (size & 1)
@@ -52,7 +56,7 @@ def _chunks(path: Path) -> tuple[WavFormat, bytes]:
 def read_wav(path: Path) -> tuple[np.ndarray, int]:
     """16-bit PCM or 32-bit float WAV -> (mono float32 in [-1, 1], sample rate)."""
     fmt, data = _chunks(Path(path))
-    if fmt.code in (PCM, EXTENSIBLE) and fmt.bits == 16:
+    if fmt.code == PCM and fmt.bits == 16:
         x = np.frombuffer(data[: len(data) // 2 * 2], "<i2").astype(np.float32) / 32768.0
     elif fmt.code == FLOAT and fmt.bits == 32:
         x = np.frombuffer(data[: len(data) // 4 * 4], "<f4").astype(np.float32)
