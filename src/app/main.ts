@@ -7,7 +7,6 @@ import type { WebGPUSupport } from '../gpu/capabilities';
 import type { TalkingFaceEngine, Backend } from '../engine/engine';
 import { decodeAudio } from '../audio/decode';
 import { Player } from '../player/player';
-import { audioNotes } from '../player/audio-notes';
 import { TakeView, animateAudio, redrawHead, type Take } from './take-view';
 import { Recording } from './recording';
 import { MicrophoneChoice } from './microphone-choice';
@@ -92,12 +91,19 @@ async function start(): Promise<void> {
 }
 
 /** The model, or null with why not: still loading (`waiting`, when given, is said while it is waited for) or failed. */
-async function needEngine(waiting?: string): Promise<TalkingFaceEngine | null> {
-  const loading = !document.body.dataset.engine;
-  if (loading && waiting) showStatus(waiting);
-  if (loading && waiting) await modelTried;
-  else if (loading) tell('The model is still loading: press Record again once it is ready.');
-  if (!engine && !loading) tell('The model is not loaded, so audio cannot be animated. Reload the page to try again.', true);
+/** The model, or null with why not: still loading, or failed. */
+function needEngine(): TalkingFaceEngine | null {
+  const failed = Boolean(document.body.dataset.engine); // ('ready' sets engine first)
+  if (!engine && document.body.dataset.ready !== 'error') tell(failed ? 'The model is not loaded, so audio cannot be animated. Reload the page to try again.' : 'The model is still loading: press Record again once it is ready.', failed); // (not started: its message stays)
+  return engine;
+}
+
+/** The model once it is in (`signal`: cancelled meanwhile, its reason thrown); an Error where it could not be loaded. */
+async function modelIn(waiting: string, signal: AbortSignal): Promise<TalkingFaceEngine> {
+  if (!engine) showStatus(waiting);
+  if (!engine) await Promise.race([modelTried, new Promise((resolve) => signal.addEventListener('abort', resolve, { once: true }))]);
+  signal.throwIfAborted();
+  if (!engine) throw new Error('the model could not be loaded (Details says why); reload the page to try again');
   return engine;
 }
 
@@ -112,9 +118,9 @@ function setBusy(controller: AbortController | null, isHeadRedraw = false): void
 
 /** Animate a clip under a cancellable busy state, then play it: opening a file is asking to hear it. */
 async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: AbortSignal) => Promise<Take | null>, headRedraw = false): Promise<void> {
-  const e = engine ?? (await needEngine(`The model is still loading: ${label} is animated once it is in…`)); // (no await once in: Escape at once cancels)
-  if (!e || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
-    if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
+  if ((!engine && document.body.dataset.engine) || recording || recordPending || finishing) { // (recordPending: the microphone is being asked for, or let go)
+    if (!engine) needEngine(); // (failed: says so)
+    else if (finishing) tell('Finishing the recording: open the file or sample once it is ready.');
     else if (recording || recordPending) tell(recording ? 'Recording: stop it first (Stop recording or Escape), then open a file or a sample.' : 'The recording is starting (the browser may be asking for the microphone): Escape cancels it; then open a file or a sample.');
     markSample(ui.sampleSelect, sampleIndex, take?.name);
     return;
@@ -125,6 +131,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
   setBusy(controller, headRedraw);
   announce(`Animating ${label}…`);
   try {
+    const e = engine ?? (await modelIn(`The model is still loading: ${label} is animated once it is in (Escape cancels)…`, controller.signal)); // (in: no await)
     const t = await run(e, controller.signal);
     if (t) {
       document.body.dataset.take = 'ready';
@@ -214,8 +221,7 @@ function stopPlayback(): void {
 
 /** Record starts and stops the microphone take. The button stays enabled (and keeps the focus) while it changes state. */
 async function toggleRecording(): Promise<void> {
-  const e = engine;
-  if (!e) await needEngine(); // says why not: still loading, or failed
+  const e = needEngine(); // (null: says why not)
   if (!e || recordPending) return;
   recordPending = true;
   ui.recordButton.setAttribute('aria-disabled', 'true');
@@ -263,10 +269,8 @@ async function stopRecording(e: TalkingFaceEngine, r: Recording): Promise<void> 
   try {
     const done = await r.finish(reanimating, controller.signal);
     if (!done) return tell('The take was too short to animate. Press Record and speak for a moment.', true);
-    const speech = await e.restUnlessSpeech(done.animation);
-    const notes = audioNotes(done.samples, done.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
     ui.clipInfo.textContent = `Recording: ${done.seconds.toFixed(1)} s.`;
-    setTake({ ...done, name: 'Recording', backend: e.backend, notes });
+    setTake({ ...done, name: 'Recording', backend: e.backend });
     const held = done.heldFrames && `Stopped animating the whole take: it keeps the live frames (the ${done.heldFrames} skipped to keep up hold the frame before them). Press Play.`;
     tell(held || takeNote || 'Recording is ready: press Play.');
     document.body.dataset.take = 'ready';
@@ -320,5 +324,7 @@ for (const b of [ui.playButton, ui.recordButton]) lockWidth(b);
 start().catch((e: Error) => {
   tell(`Could not start: ${e.message}`, true);
   document.body.dataset.ready = 'error';
+  document.body.dataset.engine ||= 'error'; // (nothing to wait for: a file opened says the model is not loaded)
+  modelSettled();
   console.error(e);
 });

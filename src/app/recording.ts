@@ -7,6 +7,7 @@ import type { TalkingFaceEngine, Animation, Frames } from '../engine/engine';
 import type { LiveSession } from '../engine/live';
 import { placeFrames } from '../engine/frames';
 import { stopTracks } from '../audio/capture';
+import { audioNotes } from '../player/audio-notes';
 
 export interface FinishedTake {
   animation: Animation;
@@ -16,6 +17,8 @@ export interface FinishedTake {
   computeMs: number;
   /** Frames of the take that hold the one before them: skipped live, and their animation cancelled (else 0). */
   heldFrames: number;
+  /** What was noticed about its sound (silent: the microphone muted?, no speech, clipped), the most important first. */
+  notes: string[];
 }
 
 export class Recording {
@@ -98,6 +101,15 @@ export class Recording {
    * that: the take is then the live frames, the skipped ones held (`heldFrames`), not lost.
    */
   async finish(onReanimate: (done: number, total: number) => void, signal?: AbortSignal): Promise<FinishedTake | null> {
+    const take = await this.animation(onReanimate, signal);
+    if (!take) return null;
+    const speech = await this.engine.restUnlessSpeech(take.animation); // (a take with no speech: the face at rest)
+    const notes = audioNotes(take.samples, take.seconds, { speech }).map((n) => n.replace('the audio is silent', 'the take is silent (is the microphone muted?)'));
+    return { ...take, notes };
+  }
+
+  /** The take's frames: the live ones, or the whole take animated again (finish). */
+  private async animation(onReanimate: (done: number, total: number) => void, signal?: AbortSignal): Promise<Omit<FinishedTake, 'notes'> | null> {
     this.finishing = true;
     const e = this.engine;
     const samples = await this.live.stop();

@@ -22,11 +22,13 @@ const MAX_WAV_HEADER = 65536;
 export class PcmReader {
   private odd: number | null = null; // the first byte of a sample split between two pieces
   private head: Uint8Array | null = new Uint8Array(0); // the stream's first bytes while they may be a WAV header; null after
+  private refused: RangeError | null = null; // a WAV header it cannot play: every later piece is refused too (not read as PCM)
 
   constructor(private readonly where: string, private readonly sampleRate?: number) {}
 
   /** The piece as float samples (a new array); throws a TypeError or RangeError that says what was wrong. */
   read(chunk: unknown): Float32Array {
+    if (this.refused) throw this.refused;
     if (chunk instanceof Float32Array || chunk instanceof Int16Array) this.head = null; // samples: no header to come
     if (chunk instanceof Float32Array) return finite(chunk.slice(), this.where);
     if (chunk instanceof Int16Array) return fromInt16(chunk);
@@ -47,7 +49,11 @@ export class PcmReader {
       if (found === 'more' && start.length > MAX_WAV_HEADER) throw new RangeError(`${this.where}: the stream begins as a WAV file but has no data chunk in its first ${MAX_WAV_HEADER} bytes`);
       this.head = found === 'more' ? start : null;
       if (found === 'more') return new Float32Array(0); // the rest of the header is still to come
-      if (found) this.check(found.format);
+      try {
+        if (found) this.check(found.format);
+      } catch (e) {
+        throw (this.refused = e as RangeError);
+      }
       piece = start.subarray(found ? found.data : 0);
     }
     let bytes = piece;

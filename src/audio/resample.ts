@@ -91,7 +91,7 @@ const SLICE_MS = 25;
  */
 export async function resampleAll(input: Float32Array, from: number, to: number, signal?: AbortSignal): Promise<Float32Array<ArrayBuffer>> {
   const resampler = new StreamResampler(from, to);
-  const out = new Float32Array(Math.max(1, Math.round((input.length * to) / from)));
+  const out = new Float32Array(Math.round((input.length * to) / from));
   let made = 0;
   const keep = (piece: Float32Array) => {
     const n = Math.min(piece.length, out.length - made);

@@ -59,8 +59,8 @@ export class TalkingFaceElement extends ElementBase {
       onFrame: (f) => this.playbackFrame(f),
       onEnded: () => {
         this.status.set(this.playingStatus.replace(/^Playing/, 'Played')); // the same notes, in the past: it is over
+        this.endings++; // (before: a listener that records the take counts this end as past)
         this.dispatchEvent(new CustomEvent('ended'));
-        this.endings++;
       },
       // Autoplay rules: the browser starts sound only after a person's gesture on the page.
       onBlocked: () => this.status.set('Click or press a key to hear it: the browser plays sound only after a gesture.'),
@@ -76,7 +76,7 @@ export class TalkingFaceElement extends ElementBase {
   set backend(value: 'auto' | Backend | null) { reflect(this, 'backend', value); }
 
   /** The take shown (posed vertices per frame; with an avatar, its blend-shape output), e.g. to export it; null before one,
-   * and once the avatar, model or template changes (what it was made for is gone: recordVideo() has nothing to replay). */
+   * and once the avatar, model or template changes or the element is removed (recordVideo() has nothing to replay). */
   get currentAnimation(): Animation | null { return this.stage.player?.take ?? null; }
 
   /** How loud the speech plays, 0 to 1 (default 1), as a media element's `volume`: the face keeps in sync at any volume. */

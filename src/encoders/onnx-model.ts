@@ -35,13 +35,16 @@ export function ortBuildFor(providers: readonly ExecutionProvider[]): OrtBuild {
 }
 
 const ortModules: Partial<Record<OrtBuild, Promise<typeof Ort>>> = {};
+/** Builds whose load failed since the last startOrt(). */
+const failedBuilds = new Set<OrtBuild>();
 /** Whether the page has said that onnxruntime's worker failed and the sessions run in the page. */
 let warnedWorkerFailure = false;
 
 /**
  * onnxruntime-web in the page: the WebGPU-capable build, or the plain one where its worker cannot run (OrtWorker).
  * Either build's WebAssembly is fetched here, with the load's stallSeconds, as onnx-worker.ts does in the worker
- * (ort-runtime.ts). A failed load is forgotten, so the next one tries again.
+ * (ort-runtime.ts). A failed load is kept for the rest of the engine's load (its other sessions do not fetch it again,
+ * one after another, before they give way to the next provider), and forgotten at the next (startOrt).
  */
 function loadOrt(build: OrtBuild): Promise<typeof Ort> {
   ortModules[build] ??= (build === 'jsep' ? import('onnxruntime-web') : import('onnxruntime-web/wasm')).then(async (ort) => {
@@ -55,7 +58,7 @@ function loadOrt(build: OrtBuild): Promise<typeof Ort> {
     });
     return ort;
   }).catch((e: unknown) => {
-    delete ortModules[build];
+    failedBuilds.add(build);
     throw e;
   });
   return ortModules[build];
@@ -100,6 +103,8 @@ class PageRunner implements Runner {
  */
 export function startOrt(providers: readonly ExecutionProvider[], stallSeconds = STALL_SECONDS): void {
   setRuntimeStallSeconds(stallSeconds);
+  for (const failed of failedBuilds) delete ortModules[failed]; // a new load tries a runtime that failed before
+  failedBuilds.clear();
   const build = ortBuildFor(providers);
   if (build === 'jsep' || !OrtWorker.get()) void loadOrt(build).catch(() => undefined); // (its error is met again at session creation)
 }

@@ -40,7 +40,6 @@ async function probe(): Promise<WebGPUSupport> {
       timer = setTimeout(() => reject(new Error(`no answer within ${ADAPTER_WAIT_MS / 1000} s`)), ADAPTER_WAIT_MS);
     })]);
   } catch (e) {
-    cached = null; // asked again next time (the answer may come then)
     return { available: false, description: `WebGPU adapter request failed: ${(e as Error).message}`, adapter: null, info: null };
   } finally {
     clearTimeout(timer);

@@ -4,7 +4,7 @@
  */
 import { checkManifest, DEFAULT_MANIFEST_URL, type Manifest } from './manifest';
 import { loadTemplate, type FaceTemplate } from '../template/face-template';
-import { fetchBody, StalledError, type FetchBodyOptions } from './fetch-body';
+import { checkedStallSeconds, fetchBody, StalledError, type FetchBodyOptions } from './fetch-body';
 
 export class ModelLoadError extends Error {
   override name = 'ModelLoadError';
@@ -47,6 +47,7 @@ export function resolveManifestUrl(url: string | URL | undefined): URL {
 
 /** The manifest at `url`, checked (ModelLoadError: missing, unreachable, stalled for `stallSeconds`, or unreadable). */
 export async function fetchManifest(url: string | URL | undefined, fetchFn: typeof fetch = fetch.bind(globalThis), stallSeconds?: number): Promise<{ manifest: Manifest; manifestUrl: URL }> {
+  if (stallSeconds !== undefined) checkedStallSeconds(stallSeconds); // (a RangeError as it is, not as a failed download)
   const manifestUrl = resolveManifestUrl(url);
   const body = await fetchBody(manifestUrl, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
     throw new ModelLoadError(`could not fetch the model manifest ${manifestUrl}: ${e.message}`);
@@ -87,6 +88,7 @@ export interface ArrivingArtefacts {
  */
 export async function fetchArtefacts(options: ArtefactOptions = {}): Promise<ArrivingArtefacts> {
   const fetchFn = options.fetch ?? fetch.bind(globalThis);
+  if (options.stallSeconds !== undefined) checkedStallSeconds(options.stallSeconds);
   const { manifest, manifestUrl } = options.manifest
     ? { manifest: checkManifest(options.manifest), manifestUrl: resolveManifestUrl(options.manifestUrl) }
     : await fetchManifest(options.manifestUrl, fetchFn, options.stallSeconds);

@@ -11,7 +11,7 @@
  * with `scripts/import-template.ts` loads through the same code.
  */
 import { boundaryLoops, buildAdjacency, type Adjacency } from './mesh-topology';
-import { fetchBody } from '../model/fetch-body';
+import { checkedStallSeconds, fetchBody } from '../model/fetch-body';
 
 export const TEMPLATE_FORMAT = 'talking-face-template';
 
@@ -193,6 +193,7 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
  * `stallSeconds` (default STALL_SECONDS) fails, naming it.
  */
 export async function loadTemplate(headerUrl: string | URL, fetchFn: typeof fetch = fetch, stallSeconds?: number): Promise<FaceTemplate> {
+  if (stallSeconds !== undefined) checkedStallSeconds(stallSeconds); // (a RangeError as it is, not as a failed download)
   const get = async (url: string | URL, what: string) => {
     const body = await fetchBody(url, { fetch: fetchFn, stallSeconds }).catch((e: Error) => {
       throw new TemplateFormatError(`could not fetch the face template's ${url}: ${e.message}`);

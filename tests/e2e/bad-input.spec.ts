@@ -60,7 +60,12 @@ test('a file opened while the model loads is animated once it is in; Record then
   await expect(page.locator('#status')).toHaveText('The model is still loading: press Record again once it is ready.');
   await expect(page.locator('#status')).not.toHaveClass(/error/);
   await page.locator('#file-input').setInputFiles(SPEECH);
-  await expect(page.locator('#status')).toHaveText('The model is still loading: speech-kal.wav is animated once it is in…');
+  const waiting = 'The model is still loading: speech-kal.wav is animated once it is in (Escape cancels)…';
+  await expect(page.locator('#status')).toHaveText(waiting);
+  await page.keyboard.press('Escape'); // it waits cancellably
+  await expect(page.locator('#status')).toHaveText('Stopped animating speech-kal.wav. Open another file or record.');
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await expect(page.locator('#status')).toHaveText(waiting);
   await expect(page.locator('body')).toHaveAttribute('data-take', 'ready', { timeout: 60_000 });
   await expect(page.locator('#play-button')).toHaveText('Pause'); // and played, as a file opened once it was in
   await expect(page.locator('#backend-select')).toBeEnabled();

@@ -101,12 +101,14 @@ for (const where of ['its worker', 'the page (no Web Workers)', 'the page (its W
 test('onnxruntime\'s WebGPU build not served (28 MB, more than some hosts allow a file): the encoders load on the wasm provider', async ({ page, context, guard }) => {
   test.setTimeout(90_000);
   guard.allowConsoleError(/404|Failed to load resource/);
-  await context.route('**/ort/*/ort-wasm-simd-threaded.jsep.wasm', (r) => r.fulfill({ status: 404, body: 'not here' }));
+  let asked = 0;
+  await context.route('**/ort/*/ort-wasm-simd-threaded.jsep.wasm', (r) => (asked++, r.fulfill({ status: 404, body: 'not here' })));
   const warnings: string[] = [];
   page.on('console', (m) => m.type() === 'warning' && warnings.push(m.text()));
   await page.goto('/dev/ort-start.html?providers=webgpu,wasm');
   await expect(page.locator('body')).toHaveAttribute('data-engine', 'ready', { timeout: 45_000 });
   expect(warnings.join('\n')).toMatch(/the webgpu provider failed \(onnxruntime's runtime .*jsep\.wasm could not be downloaded \(HTTP 404/);
+  expect(asked, 'asked for once, not again by each of the four sessions').toBe(1);
 });
 
 test('the demo served without sample clips offers only what there is', async ({ page, context, guard }) => {

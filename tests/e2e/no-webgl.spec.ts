@@ -1,5 +1,6 @@
 import { test, expect } from './fixtures';
 import { CHROMIUM_ARGS } from '../../playwright.config';
+import { SPEECH } from './helpers/audio';
 
 /**
  * A browser that gives no WebGL (hardware acceleration turned off, a graphics driver it blocks with no software
@@ -18,6 +19,12 @@ test('the demo says plainly that this browser cannot draw the face, and what to 
   await expect(page.locator('body')).toHaveAttribute('data-ready', 'error', { timeout: 60_000 });
   await expect(page.locator('#status')).toHaveText(PLAIN);
   await expect(page.locator('#status')).not.toContainText('THREE');
+  // A file opened then waits for nothing: the message stays, not "still loading" for ever.
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await page.waitForTimeout(500);
+  await expect(page.locator('#status')).toHaveText(PLAIN);
+  await page.locator('#record-button').click();
+  await expect(page.locator('#status')).toHaveText(PLAIN);
 });
 
 test('<talking-face> without WebGL: one render error, ready (drawn: false), and speech still plays with its frame events', async ({ page }) => {

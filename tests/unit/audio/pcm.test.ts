@@ -74,6 +74,9 @@ describe('PcmReader', () => {
     expect(() => new PcmReader('write', 16000).read(wavStream([1]))).toThrow(/write: the stream is a WAV file \(mono, 16-bit PCM, 24000 Hz\); it takes mono 16-bit PCM at the stream's sampleRate \(16000 Hz\)/);
     expect(() => new PcmReader('write', 24000).read(wavStream([1], { channels: 2 }))).toThrow(/\(2 channels, 16-bit PCM, 24000 Hz\)/);
     expect(() => new PcmReader('write', 24000).read(wavStream([1], { tag: 3, bits: 32 }))).toThrow(/\(mono, 32-bit float, 24000 Hz\)/);
+    const r = new PcmReader('write', 16000);
+    expect(() => r.read(wavStream([1]))).toThrow(RangeError);
+    expect(() => r.read(new Uint8Array(8)), 'the pieces after it are refused too, not played as PCM').toThrow(/the stream is a WAV file/);
   });
 
   it('says what it takes when given something else, and refuses samples that are not finite', () => {

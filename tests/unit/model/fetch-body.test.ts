@@ -46,6 +46,11 @@ describe('fetchBody', () => {
     for (const stallSeconds of [0, -1, NaN, '30']) {
       await expect(fetchBody('http://test/a', { fetch: served(() => streaming(1, 0, true)), stallSeconds: stallSeconds as number })).rejects.toThrow(RangeError);
     }
+    // The public loaders say so as it is, not as a download that failed (nothing was fetched).
+    const unfetched = (() => { throw new Error('fetched'); }) as unknown as typeof fetch;
+    await expect(loadTemplate('http://test/t.json', unfetched, 0)).rejects.toThrow(RangeError);
+    await expect(fetchManifest('http://test/m.json', unfetched, -1)).rejects.toThrow(RangeError);
+    await expect(fetchArtefacts({ manifestUrl: 'http://test/m.json', fetch: unfetched, stallSeconds: NaN })).rejects.toThrow(RangeError);
   });
 
   it('fails when the headers never come, even from a fetch that ignores its abort signal', async () => {
