@@ -14,8 +14,11 @@ export interface WebGPUSupport {
 
 let cached: Promise<WebGPUSupport> | null = null;
 
-/** How long the browser may take to answer for an adapter before the page goes on without WebGPU (the spec lets it wait). */
-const ADAPTER_WAIT_MS = 10_000;
+/**
+ * How long the browser may take to answer for an adapter before the page goes on without WebGPU (the spec lets it
+ * wait). Generous: a software GPU still busy with the page before (SwiftShader after a WebGPU animation) took 15 s.
+ */
+const ADAPTER_WAIT_MS = 60_000;
 
 /** A hardware adapter: what 'auto' chooses WebGPU for (a software one, SwiftShader, is slower than the CPU path). */
 export function isHardwareAdapter(support: WebGPUSupport): boolean {

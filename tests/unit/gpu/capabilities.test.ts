@@ -47,8 +47,8 @@ describe('detectWebGPU', () => {
       const requestAdapter = vi.fn(() => new Promise<never>(() => undefined));
       const m = await fresh({ requestAdapter });
       const probed = m.detectWebGPU();
-      await vi.advanceTimersByTimeAsync(10_000);
-      expect(await probed).toMatchObject({ available: false, description: expect.stringMatching(/no answer within 10 s/) });
+      await vi.advanceTimersByTimeAsync(60_000);
+      expect(await probed).toMatchObject({ available: false, description: expect.stringMatching(/no answer within 60 s/) });
       expect(await m.detectWebGPU()).toBe(await probed); // (not another 10 s for every later caller)
       expect(requestAdapter).toHaveBeenCalledTimes(1);
     } finally {
