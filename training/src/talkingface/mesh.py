@@ -78,7 +78,10 @@ def read_ply(path: Path) -> Mesh:
     if fmt not in ("ascii", "binary_little_endian"):
         raise MeshFormatError(f"{path}: PLY format {fmt!r} is not supported (use ascii or binary_little_endian)")
     body = _AsciiBody(data[body_start:]) if fmt == "ascii" else _BinaryBody(data, body_start)
-    rows = _ply_rows(body, elements)
+    try:
+        rows = _ply_rows(body, elements)
+    except (ValueError, IndexError, KeyError) as e:  # a number that is none, a body cut short, a type PLY has not
+        raise MeshFormatError(f"{path}: {e}") from e
     if "vertex" not in rows or "face" not in rows:
         raise MeshFormatError(f"{path}: PLY needs vertex and face elements")
     vrows = rows["vertex"]
@@ -118,6 +121,8 @@ class _AsciiBody:
 
     def _take(self, n: int) -> list[bytes]:
         out = self.tokens[self.pos : self.pos + n]
+        if len(out) < n:
+            raise MeshFormatError("the PLY body ends before the counts its header states (cut short?)")
         self.pos += n
         return out
 
@@ -128,7 +133,8 @@ class _AsciiBody:
         return float(self._take(1)[0])
 
     def items(self, ptype: str, n: int) -> list:
-        return [int(x) for x in self._take(n)]
+        kind = int if _PLY_TYPES[ptype][0] in "iu" else float  # (a list of floats: per-face texture coordinates)
+        return [kind(x) for x in self._take(n)]
 
 
 class _BinaryBody:

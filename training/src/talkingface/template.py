@@ -91,7 +91,10 @@ def load_template(path: str | Path, masks: str | Path | None = None) -> Template
     if suffix in (".obj", ".ply"):
         if masks is None:
             raise TemplateFormatError(f"{path.name}: a mesh template needs a masks file with its regions (docs/templates.md)")
-        m = json.loads(Path(masks).read_text())
+        try:
+            m = json.loads(Path(masks).read_text())
+        except json.JSONDecodeError as e:
+            raise TemplateFormatError(f"masks file {masks} is not valid JSON: {e}") from e
         try:
             verts, tris, uvs = read_obj(path) if suffix == ".obj" else read_ply(path)
         except MeshFormatError as e:  # the template loader's one error type; the mesh reader's reason kept
@@ -120,6 +123,13 @@ def template_from_mesh(id: str, units: str, vertices, triangles, regions: dict, 
 
 
 def _load_native(path: Path) -> Template:
+    try:
+        return _read_native(path)
+    except (KeyError, TypeError) as e:  # a field it must have is missing, or is not what it must be
+        raise TemplateFormatError(f"{path}: the template header lacks or misstates {e} (re-export it: npm run import-template)") from e
+
+
+def _read_native(path: Path) -> Template:
     try:
         header = json.loads(path.read_text())
     except json.JSONDecodeError as e:
