@@ -164,7 +164,7 @@ export class OnnxModel {
         const why = (e as Error).message.split('\n')[0];
         const error = new ModelLoadError(/unsafe-eval|Content Security Policy/i.test(why)
           ? `the page's Content-Security-Policy does not let onnxruntime compile its WebAssembly: add 'wasm-unsafe-eval' to its script-src (${why})`
-          : `onnxruntime's WebAssembly runtime (ort-wasm-*.wasm under ${ortRoot()}<version>/) could not be loaded${runtimeMissing(why) ? '' : '; reload or try again'} (${why})`);
+          : `onnxruntime's WebAssembly runtime (ort-wasm-simd-threaded.mjs and .wasm under ${ortRoot()}<version>/) could not be loaded${runtimeMissing(why) ? '' : '; reload or try again'} (${why})`);
         OrtWorker.discard(worker, error);
         throw error;
       }
