@@ -240,8 +240,8 @@ export class TalkingFaceEngine {
   }
 
   /** Live: animate a MediaStream (e.g. from openMicrophone()) while it plays; stop() returns the take. */
-  listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
-    if (this.pipeline.disposed) return Promise.reject(new EngineDisposedError()); // (the microphone's capture not started)
+  async listen(media: MediaStream, onFrames: (first: number, frames: Frames) => void, options?: LiveOptions): Promise<LiveSession> {
+    if (this.pipeline.disposed) throw new EngineDisposedError(); // (the microphone's capture not started; a bad option rejects too, not throws)
     const stream = this.createStream(onFrames,
       { maxLagFrames: LiveSession.maxLag(options), blendshapes: options?.blendshapes, headMotionScale: options?.headMotionScale });
     return LiveSession.start(stream, media, options);

@@ -27,6 +27,7 @@ export class LiveSession {
   private stopping: Promise<Float32Array> | null = null;
   private closed = false; // the capture has delivered its last piece
   private failed: Error | null = null;
+  private onError: LiveOptions['onError'];
 
   private constructor(
     readonly stream: StreamSession,
@@ -37,6 +38,7 @@ export class LiveSession {
   /** Capture `media` into `stream` (made with maxLagFrames = LiveSession.maxLag(options): see LiveOptions). */
   static async start(stream: StreamSession, media: MediaStream, options: LiveOptions = {}): Promise<LiveSession> {
     const session = new LiveSession(stream, null, options.keepAudio ?? true);
+    session.onError = options.onError;
     session.capture = await AudioCapture.start(media, stream.sampleRate, (piece) => session.receive(piece, options.onError), options);
     return session;
   }
@@ -73,12 +75,20 @@ export class LiveSession {
     }
   }
 
-  /** Stop capturing, emit the remaining frames, and return the take (empty when keepAudio is false). */
+  /**
+   * Stop capturing, emit the remaining frames, and return the take (empty when keepAudio is false). The last frames
+   * failing (onError tells it) does not lose the take: its sound is returned all the same.
+   */
   stop(): Promise<Float32Array> {
     this.stopping ??= (async () => {
       await this.capture?.stop(); // the worklet's last pieces arrive before this resolves
       this.closed = true;
-      if (!this.failed) await this.stream.end();
+      try {
+        if (!this.failed) await this.stream.end();
+      } catch (e) {
+        this.failed = e as Error; // the last frames could not be made: told, and the take's sound is still returned
+        this.onError?.(this.failed);
+      }
       const take = new Float32Array(this.keepAudio ? this.samples : 0);
       let o = 0;
       for (const p of this.pieces) {

@@ -69,6 +69,7 @@ export class StreamSession {
   push(samples: Float32Array): Promise<void> {
     if (this.ended) throw new Error(`StreamSession: push() after ${this.cancelled ? 'cancel' : 'end'}()`);
     this.append(checkedSamples(samples, 'StreamSession.push'));
+    if (samples.length === 0) return this.pending ?? Promise.resolve(); // (nothing new: no arrival kept, no drain)
     this.arrivals.push({ end: this.received, time: performance.now() });
     // Pushes that come while a drain runs share one follow-up drain: at most one waits, however fast
     // the pieces come. Each drain first yields to the event loop, so a page stays responsive (promise

@@ -73,4 +73,14 @@ describe('StreamSession', () => {
     expect(firsts[0]).toBe(stream.skippedFrames);
     expect(stream.framesProduced).toBe(28);
   });
+
+  it('empty pushes keep nothing and start no drain: a page that pushes whatever arrives does not grow the session', async () => {
+    const calls: [number, number, number][] = [];
+    const stream = new StreamSession(standIn(calls), () => undefined);
+    for (let i = 0; i < 1000; i++) await stream.push(new Float32Array(0));
+    expect((stream as unknown as { arrivals: unknown[] }).arrivals.length).toBe(0);
+    await stream.push(new Float32Array(600));
+    await stream.end();
+    expect(stream.framesProduced).toBe(6);
+  });
 });
