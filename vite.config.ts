@@ -1,6 +1,6 @@
 import { defineConfig, defaultClientConditions, type Plugin } from 'vite';
 import { createReadStream, existsSync, statSync, cpSync, readFileSync } from 'node:fs';
-import { resolve, normalize, sep, extname } from 'node:path';
+import { basename, resolve, normalize, sep, extname } from 'node:path';
 import { ISOLATION_HEADERS, MIME, precompress, serveBuild } from './scripts/hosting.ts';
 import { captureWorkletFile } from './scripts/worklet-file.ts';
 
@@ -72,7 +72,8 @@ function modelsDir(): Plugin {
     },
     transformIndexHtml: { order: 'post', handler: (_html, ctx) => (ctx.path === '/index.html' ? modelPreloads() : []) },
     closeBundle() {
-      cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true, preserveTimestamps: true });
+      // (not an export's staging folder, .export-*, that a killed export left behind)
+      cpSync(MODELS_DIR, resolve(outDir, 'models'), { recursive: true, preserveTimestamps: true, filter: (from) => !basename(from).startsWith('.export-') });
       for (const f of ORT_FILES) cpSync(resolve(ORT_DIST, f), resolve(outDir, 'ort', ORT_VERSION, f), { preserveTimestamps: true });
       precompress(outDir);
     },

@@ -60,6 +60,23 @@ export interface Server {
   stop(): void;
 }
 
+/** The servers started and not yet stopped: each in its own process group (detached), which Ctrl-C does not reach. */
+const running = new Set<() => void>();
+let signalsHeld = false;
+
+/** Ctrl-C (or a SIGTERM) stops every server still running, then the script: its `finally` would not run, and a server
+ * left behind would hold its port for the next run. */
+function stopOnSignals(): void {
+  if (signalsHeld) return;
+  signalsHeld = true;
+  for (const signal of ['SIGINT', 'SIGTERM'] as const) {
+    process.once(signal, () => {
+      for (const stop of [...running]) stop();
+      process.exit(128 + (signal === 'SIGINT' ? 2 : 15));
+    });
+  }
+}
+
 export function startServer(command: string, args: string[], cwd: string): Server {
   const child = spawn(command, args, { cwd, stdio: ['ignore', 'pipe', 'pipe'], detached: true });
   let output = '';
@@ -68,20 +85,15 @@ export function startServer(command: string, args: string[], cwd: string): Serve
   child.stderr.on('data', keep);
   const exited = () => child.exitCode ?? child.signalCode;
   const stop = (): void => {
+    running.delete(stop);
     try {
       process.kill(-child.pid!);
     } catch {
       /* already gone */
     }
   };
-  // Its own process group (detached): Ctrl-C reaches only the script, whose `finally` then does not run. Stopped here
-  // instead, or it would hold its port for the next run.
-  for (const signal of ['SIGINT', 'SIGTERM'] as const) {
-    process.once(signal, () => {
-      stop();
-      process.exit(128 + (signal === 'SIGINT' ? 2 : 15));
-    });
-  }
+  running.add(stop);
+  stopOnSignals();
   return {
     async ready(url: string, seconds = 60): Promise<void> {
       const deadline = Date.now() + seconds * 1000;

@@ -90,8 +90,7 @@ async function start(): Promise<void> {
   }
 }
 
-/** The model, or null with why not: still loading (`waiting`, when given, is said while it is waited for) or failed. */
-/** The model, or null with why not: still loading, or failed. */
+/** The model, or null with why not: still loading, or failed (where the demo could not start, its message stays). */
 function needEngine(): TalkingFaceEngine | null {
   const failed = Boolean(document.body.dataset.engine); // ('ready' sets engine first)
   if (!engine && document.body.dataset.ready !== 'error') tell(failed ? 'The model is not loaded, so audio cannot be animated. Reload the page to try again.' : 'The model is still loading: press Record again once it is ready.', failed); // (not started: its message stays)
@@ -142,7 +141,7 @@ async function animateTake(label: string, run: (e: TalkingFaceEngine, signal: Ab
       if (busy !== controller) return; // another clip took its place: that one speaks for itself
       tell(headRedraw ? 'Stopped drawing the head again: the take is as it was.' : `Stopped animating ${label}. Open another file or record.`);
       document.body.dataset.take = take ? 'ready' : 'cancelled';
-    } else {
+    } else if (document.body.dataset.ready !== 'error') { // (the demo could not start meanwhile: its message stays)
       tell(`Could not ${label === 'the sample' ? 'open the sample' : `animate ${label}`}: ${(err as Error).message}`, true);
       document.body.dataset.take = 'error';
     }

@@ -27,6 +27,20 @@ test('the demo says plainly that this browser cannot draw the face, and what to 
   await expect(page.locator('#status')).toHaveText(PLAIN);
 });
 
+test('a file opened while the demo starts, which then cannot draw the face: the message that says why stays', async ({ page, guard }) => {
+  guard.allowConsoleError(/^Error: this browser cannot draw 3D here/);
+  await page.route('**/models/template/template.json', async (route) => { // the face is built (and fails) 2 s in
+    await new Promise((resolve) => setTimeout(resolve, 2000));
+    await route.continue();
+  });
+  await page.goto('/', { waitUntil: 'domcontentloaded' });
+  await page.locator('#file-input').setInputFiles(SPEECH);
+  await expect(page.locator('#status')).toContainText('is animated once it is in'); // waiting, as the start then fails
+  await expect(page.locator('body')).toHaveAttribute('data-ready', 'error', { timeout: 60_000 });
+  await page.waitForTimeout(1000);
+  await expect(page.locator('#status')).toHaveText(PLAIN);
+});
+
 test('<talking-face> without WebGL: one render error, ready (drawn: false), and speech still plays with its frame events', async ({ page }) => {
   test.setTimeout(120_000);
   await page.addInitScript(() => {

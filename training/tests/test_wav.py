@@ -52,3 +52,6 @@ def test_a_damaged_fmt_chunk_is_said_not_divided_by(tmp_path):
     (tmp_path / "z.wav").write_bytes(_wav(_extensible(1, 16, channels=0), bytes(4)))
     with pytest.raises(WavError, match=r"fmt chunk is damaged \(0 channels"):
         wav_seconds(tmp_path / "z.wav")
+    (tmp_path / "adpcm.wav").write_bytes(_wav(_extensible(0x11, 4), bytes(4)))  # IMA ADPCM: 4 bits, a codec, not damage
+    with pytest.raises(WavError, match="encoding 17 with 4 bits is not supported"):
+        wav_seconds(tmp_path / "adpcm.wav")

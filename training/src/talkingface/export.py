@@ -170,6 +170,8 @@ def export(checkpoint: Path, out: Path, template: Template | None = None, ck: di
     the browser does not run, a missing key, Ctrl-C) leaves `out` as it was, not its ONNX files replaced beside the
     old manifest (which the browser would then refuse as corrupt)."""
     out.mkdir(parents=True, exist_ok=True)
+    for left in out.glob(".export-*"):  # an export killed outright (no `finally`) left its staging folder
+        shutil.rmtree(left, ignore_errors=True)
     stage = Path(tempfile.mkdtemp(prefix=".export-", dir=out))
     try:
         manifest = _export_into(stage, checkpoint, out, template, ck)

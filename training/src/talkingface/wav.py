@@ -43,8 +43,10 @@ def _chunks(path: Path) -> tuple[WavFormat, bytes]:
             if code == EXTENSIBLE and len(body) >= 26:  # its sub-format GUID begins with the code it stands for
                 code = int.from_bytes(body[24:26], "little")
             fmt = WavFormat(code, int.from_bytes(body[2:4], "little"), int.from_bytes(body[4:8], "little"), int.from_bytes(body[14:16], "little"))
-            if fmt.channels < 1 or fmt.sample_rate < 1 or fmt.bits < 8 or fmt.bits % 8:
-                raise WavError(f"{path}: its fmt chunk is damaged ({fmt.channels} channels, {fmt.sample_rate} Hz, {fmt.bits} bits)")
+            if fmt.channels < 1 or fmt.sample_rate < 1:
+                raise WavError(f"{path}: its fmt chunk is damaged ({fmt.channels} channels, {fmt.sample_rate} Hz)")
+            if fmt.bits < 8 or fmt.bits % 8:  # (a compressed codec: ADPCM's 4 bits, GSM's 0)
+                raise WavError(f"{path}: WAV encoding {fmt.code} with {fmt.bits} bits is not supported (use 16-bit PCM or float32)")
         elif cid == b"data":
             data = body
         pos += 8 + size + (size & 1)
