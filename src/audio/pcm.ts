@@ -2,6 +2,7 @@
  * Raw audio that arrives in pieces (a streaming text-to-speech, a voice agent's socket) as mono samples: float
  * samples in -1..1, 16-bit integers, or the bytes of 16-bit little-endian PCM as most speech services send them.
  */
+import { ascii, wavFormat } from './sniff';
 
 /** What a piece of streamed speech may be (SpeechStream.write). */
 export type PcmChunk = Float32Array | Int16Array | ArrayBuffer | SharedArrayBuffer | Uint8Array | DataView;
@@ -86,9 +87,7 @@ export class PcmReader {
   }
 }
 
-interface WavFormat { tag: number; channels: number; rate: number; bits: number }
-
-const ascii = (b: Uint8Array, at: number) => String.fromCharCode(b[at], b[at + 1], b[at + 2], b[at + 3]);
+type WavFormat = ReturnType<typeof wavFormat>;
 
 /**
  * Where a WAV header at the start of `b` ends (its data chunk's first byte) and the format it states; 'more' while
@@ -97,17 +96,16 @@ const ascii = (b: Uint8Array, at: number) => String.fromCharCode(b[at], b[at + 1
 function wavData(b: Uint8Array): { data: number; format: WavFormat } | 'more' | null {
   const riff = [0x52, 0x49, 0x46, 0x46]; // "RIFF"
   if (b.length < 12) return riff.every((c, i) => i >= b.length || b[i] === c) ? 'more' : null;
-  if (ascii(b, 0) !== 'RIFF' || ascii(b, 8) !== 'WAVE') return null;
+  if (ascii(b, 0, 4) !== 'RIFF' || ascii(b, 8, 4) !== 'WAVE') return null;
   const v = new DataView(b.buffer, b.byteOffset, b.byteLength);
   let format: WavFormat | null = null;
   for (let at = 12; ; ) {
     if (at + 8 > b.length) return 'more';
     const size = v.getUint32(at + 4, true);
-    if (ascii(b, at) === 'data') return { data: at + 8, format: format ?? { tag: 0, channels: 0, rate: 0, bits: 0 } }; // (none: refused)
-    if (ascii(b, at) === 'fmt ') {
+    if (ascii(b, at, 4) === 'data') return { data: at + 8, format: format ?? { tag: 0, channels: 0, rate: 0, bits: 0 } }; // (none: refused)
+    if (ascii(b, at, 4) === 'fmt ') {
       if (at + 24 > b.length) return 'more';
-      const tag = v.getUint16(at + 8, true);
-      format = { tag: tag === 0xfffe && at + 34 <= b.length ? v.getUint16(at + 32, true) : tag, channels: v.getUint16(at + 10, true), rate: v.getUint32(at + 12, true), bits: v.getUint16(at + 22, true) };
+      format = wavFormat(v, at);
     }
     at += 8 + size + (size % 2);
   }

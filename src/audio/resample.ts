@@ -33,6 +33,11 @@ export class StreamResampler {
     return this.half / this.from;
   }
 
+  /** The last outputs, after the last piece: the kernel holds back half its width, which zeros past the end bring out (and a few more). */
+  flush(): Float32Array {
+    return this.push(new Float32Array(Math.ceil(this.delaySeconds * this.from) + 2));
+  }
+
   push(input: Float32Array): Float32Array {
     if (this.from === this.to) return input.slice();
     // history holds input samples [received - history.length, received).
@@ -106,8 +111,7 @@ export async function resampleAll(input: Float32Array, from: number, to: number,
     signal?.throwIfAborted();
     slice = performance.now();
   }
-  // It holds back half its kernel: zeros after the end bring the last samples out.
-  keep(resampler.push(new Float32Array(Math.ceil(resampler.delaySeconds * from) + 2)));
+  keep(resampler.flush());
   return out;
 }
 

@@ -28,7 +28,15 @@ const NOT_AUDIO: [string, number[]][] = [
   ['a ZIP archive (or an Office document)', [0x50, 0x4b, 0x03, 0x04]],
 ];
 
-const ascii = (b: Uint8Array, at: number, n: number) => String.fromCharCode(...b.subarray(at, at + n));
+/** `n` bytes of `b` from `at` as text (a chunk's id, a file's signature). */
+export const ascii = (b: Uint8Array, at: number, n: number): string => String.fromCharCode(...b.subarray(at, at + n));
+
+/** A WAV fmt chunk's format (the chunk's header at `at`; 24 bytes of it there): WAVE_FORMAT_EXTENSIBLE as its sub-format. */
+export function wavFormat(v: DataView, at: number): { tag: number; channels: number; rate: number; bits: number } {
+  const tag = v.getUint16(at + 8, true);
+  return { tag: tag === 0xfffe && at + 34 <= v.byteLength ? v.getUint16(at + 32, true) : tag,
+    channels: v.getUint16(at + 10, true), rate: v.getUint32(at + 12, true), bits: v.getUint16(at + 22, true) };
+}
 
 /**
  * Why `bytes` could not be decoded, as a clause for a message ("it is a PNG image, not audio"), or null where the
@@ -55,11 +63,7 @@ function wavReason(v: DataView): string {
   for (let at = 12; at + 8 <= v.byteLength;) {
     const id = String.fromCharCode(v.getUint8(at), v.getUint8(at + 1), v.getUint8(at + 2), v.getUint8(at + 3));
     const size = v.getUint32(at + 4, true);
-    if (id === 'fmt ' && at + 24 <= v.byteLength) {
-      tag = v.getUint16(at + 8, true);
-      bits = v.getUint16(at + 22, true);
-      if (tag === 0xfffe && at + 34 <= v.byteLength) tag = v.getUint16(at + 32, true); // WAVE_FORMAT_EXTENSIBLE: its sub-format
-    }
+    if (id === 'fmt ' && at + 24 <= v.byteLength) ({ tag, bits } = wavFormat(v, at));
     if (id === 'data') data = Math.min(size, v.byteLength - at - 8);
     at += 8 + size + (size % 2);
   }

@@ -209,7 +209,7 @@ export class SpeechStream {
   private async finish(): Promise<void> {
     try {
       // The resampler holds back half its kernel: zeros after the end bring the last samples out, and no more.
-      const tail = this.resampler!.push(new Float32Array(Math.ceil(this.resampler!.delaySeconds * this.sampleRate) + 2));
+      const tail = this.resampler!.flush();
       const model = this.started!.engine.manifest.audio.sample_rate;
       const missing = Math.round((this.written / this.sampleRate) * model) - this.pushed;
       if (missing > 0) await this.push(tail.subarray(0, missing));
