@@ -17,7 +17,7 @@ import { TALKINGHEAD_SHAPES, talkingHeadAngles } from '../../src/avatar/talkingh
 const CHECKED = ['jawOpen', 'mouthClose', 'mouthFunnel', 'mouthPucker', 'mouthSmileLeft', 'mouthLowerDownLeft', 'mouthUpperUpRight', 'mouthRollLower'] as const;
 
 interface Sample {
-  /** The frame the page set (-1 before the first), and the frame of the audio clock at the instant of sampling. */
+  /** The frame the page set (-1 before the first), and the frame of the heard audio clock at the instant of sampling. */
   frame: number;
   audioFrame: number;
   /** Milliseconds since the last step of TalkingHead's loop (it steps at most 30 times a second, on animation frames). */
@@ -37,13 +37,15 @@ function startSampling(page: Page, checked: readonly string[]) {
     const g = globalThis as unknown as { talkingHeadExample: { head: any; state: any }; samples: unknown[]; sampler: number };
     const { head, state } = g.talkingHeadExample;
     g.samples = [];
+    const heard = (c: AudioContext) => c.currentTime - (c.baseLatency || 0) - (c.outputLatency || 0);
     g.sampler = setInterval(() => {
       const mesh = head.morphs[0];
       const anim = head.animQueue.find((a: { template: { name: string } }) => a.template.name === 'blendshapes');
       const d = head.poseDelta.props['Head.quaternion'];
       g.samples.push({
         frame: state.frame,
-        audioFrame: state.source ? Math.floor((state.context.currentTime - state.startedAt) * state.take.fps) : -1,
+        // The heard clock, as the page reads it (heardTime: currentTime less the output's latency).
+        audioFrame: state.source ? Math.floor((heard(state.context) - state.startedAt) * state.take.fps) : -1,
         sinceStep: performance.now() - head.animTimeLast,
         animTime: anim ? head.animClock - anim.ts[0] : null,
         influences: Object.fromEntries(names.map((n: string) => [n, mesh.morphTargetInfluences[mesh.morphTargetDictionary[n]]])),
