@@ -8,6 +8,10 @@
  *
  *   gap' = g - c g        c = clamp(-(du - dl) / g_ref, 0, 1)        g_ref(x) = g(x) * reference / lipGap(face)
  *
+ * Where the face's lips already touch (g <= MIN_GAP_MM: a face modelled with its mouth shut, or beyond the corners)
+ * every closing is a full one: the model's closing is taken out there and the lips stay touching (it pressed them
+ * through each other by its whole closing, 7.5 mm on /p b m/); an opening is the model's.
+ *
  * Before that, the mouth's amplitude: the model's offsets on the lips' tissue and the jaw are scaled by the
  * manifest's mouth gain, fading to 1 with the rig's fields (a regression opens the mouth by about three quarters of
  * the truth's motion).
@@ -18,7 +22,7 @@ import { faceFields } from '../avatar/fields';
 import { innerLipGaps } from '../template/lip-gap';
 import type { FaceTemplate } from '../template/face-template';
 
-/** Below this the face's lips already touch at that x (mm): nothing to retarget there (MIN_GAP_MM). */
+/** Below this the face's lips already touch at that x (mm): the model's closing is taken out there (MIN_GAP_MM). */
 const MIN_GAP_MM = 0.05;
 
 /** Where x falls on an ascending contour: its two neighbours and the weight of the second (np.interp's rule). */
@@ -72,19 +76,19 @@ export class LipClosure {
       const yu = (1 - tu) * Y(f.upperLip[ku]) + tu * Y(f.upperLip[ku + 1]);
       const yl = (1 - tl) * Y(f.lowerLip[kl]) + tl * Y(f.lowerLip[kl + 1]);
       const g = Math.max(yu - yl, 0);
-      if (w !== 0 && g > MIN_GAP_MM) rows.push({ i, ku, tu, kl, tl, g, w });
+      if (w !== 0) rows.push({ i, ku, tu, kl, tl, g, w });
     }
     this.active = Int32Array.from(rows, (r) => r.i);
     this.up = Int32Array.from(rows.flatMap((r) => [f.upperLip[r.ku], f.upperLip[r.ku + 1]]));
     this.lo = Int32Array.from(rows.flatMap((r) => [f.lowerLip[r.kl], f.lowerLip[r.kl + 1]]));
     this.tUp = Float64Array.from(rows, (r) => r.tu);
     this.tLo = Float64Array.from(rows, (r) => r.tl);
-    this.gap = Float64Array.from(rows, (r) => r.g);
+    this.gap = Float64Array.from(rows, (r) => (r.g > MIN_GAP_MM ? r.g : 0)); // 0: the lips touch there
     this.ref = Float64Array.from(rows, (r) => r.g * scale);
     this.field = Float64Array.from(rows, (r) => r.w);
   }
 
-  /** Vertices it can move (the lips' tissue where the face's lips part). */
+  /** Vertices it can move (the lips' tissue). */
   get vertexCount(): number {
     return this.active.length;
   }
@@ -105,6 +109,10 @@ export class LipClosure {
       for (let k = 0; k < m; k++) {
         const du = (1 - this.tUp[k]) * y(this.up[2 * k]) + this.tUp[k] * y(this.up[2 * k + 1]);
         const dl = (1 - this.tLo[k]) * y(this.lo[2 * k]) + this.tLo[k] * y(this.lo[2 * k + 1]);
+        if (this.gap[k] === 0) {
+          dy[k] = Math.min(du - dl, 0) * this.field[k];
+          continue;
+        }
         const c = Math.min(1, Math.max(0, -(du - dl) / this.ref[k]));
         dy[k] = c * (this.gap[k] - this.ref[k]) * this.field[k];
       }

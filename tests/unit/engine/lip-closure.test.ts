@@ -25,15 +25,16 @@ const gaps = (face: Float32Array, offsets: Float32Array, frames: number) => {
 };
 
 describe.runIf(reference !== undefined)('lip closure', () => {
-  it('equals PyTorch on the template\'s face and on a face with wider-parted lips', () => {
+  it('equals PyTorch on the template\'s face, on a face with wider-parted lips and on one whose lips meet', () => {
     const input = f32(fx, 'lips_in');
     const count = input.length / (n * 3);
-    for (const [face, want] of [['template_mm', 'lips_out'], ['template_wider_mm', 'lips_out_wider']] as const) {
+    for (const [face, want] of [['template_mm', 'lips_out'], ['template_wider_mm', 'lips_out_wider'], ['template_shut_mm', 'lips_out_shut']] as const) {
       const offsets = input.slice();
       new LipClosure(withFace(f32(fx, face)), reference!, gain).apply(offsets, count, n);
       expect(maxAbsDiff(offsets, f32(fx, want))).toBeLessThan(1e-4); // mm
     }
     expect(maxAbsDiff(input, f32(fx, 'lips_out_wider'))).toBeGreaterThan(0.5); // the fixture closes lips: it can fail
+    expect(maxAbsDiff(input, f32(fx, 'lips_out_shut'))).toBeGreaterThan(0.5);  // and takes a closing out
   });
 
   it('closes the lips of any face on the model\'s full closure, and leaves an opening alone', () => {
@@ -43,10 +44,13 @@ describe.runIf(reference !== undefined)('lip closure', () => {
     const lower = new Float64Array(n);
     const upperRegion = new Set(template.regions.lips_inner_upper);
     for (const v of template.regions.lips_inner_lower) if (!upperRegion.has(v)) lower[v] = 1;
-    for (const wider of [0, 1.5, -1]) {
-      const face = Float32Array.from(base, (v, i) => (i % 3 === 1 ? v - wider * lower[Math.floor(i / 3)] : v));
+    for (const wider of [0, 1.5, -1, -Infinity]) {
+      // -Infinity: the lower lip raised until the lips meet at rest (a face modelled with its mouth shut).
+      const by = wider === -Infinity ? -new LipClosure(template, reference!).faceGap : wider;
+      const face = Float32Array.from(base, (v, i) => (i % 3 === 1 ? v - by * lower[Math.floor(i / 3)] : v));
       const c = new LipClosure(withFace(face), reference!);
       const g = c.faceGap;
+      if (wider === -Infinity) expect(g).toBeLessThan(0.05);
       const offsets = new Float32Array(2 * n * 3);
       for (let v = 0; v < n; v++) {
         offsets[3 * v + 1] = (reference! * lower[v]);   // frame 0: the reference gap closed

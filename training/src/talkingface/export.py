@@ -258,7 +258,8 @@ def _export_into(stage: Path, checkpoint: Path, out: Path, template: Template | 
                          "calibrated_on": closure.get("split"),
                          "rule": "the model's offsets first scaled by 1 + (mouth_gain - 1) clamp(max(jaw field, lip fields), 0, 1); then "
                                  "at each x across the mouth, c = clamp(-(du - dl) / g_ref(x), 0, 1) of those offsets; the lips "
-                                 "close by c (g(x) - g_ref(x)) more, with the rig's lip fields; g the face's gap, g_ref = g * reference / lip gap "
+                                 "close by c (g(x) - g_ref(x)) more, with the rig's lip fields; g the face's gap, g_ref = g * reference / lip gap; "
+                                 "where the face's lips touch (g <= 0.05 mm) their closing, min(du - dl, 0), is taken out "
                                  "(training/src/talkingface/model/lip_closure.py)"}
                         if closure else None),
         "heads": {"displacement": "Linear(d, 3), mm", "pose": f"Linear(d, 6): rotation = {cfg.max_rotation} tanh(x[0:3]) (axis-angle, rad), translation = {cfg.max_translation_mm} tanh(x[3:6]) mm; y = R (I + O) + t"},

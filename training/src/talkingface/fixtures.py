@@ -25,7 +25,8 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     """Every intermediate tensor of one short clip, from the same code paths the browser mirrors; with the head's
     own motion (model/head_motion.py) when given: its residuals for seed 0, and the poses and vertices with it;
     with the lip closure (model/lip_closure.py) when given: the offsets it gives the template's face, and those
-    of a face with its lips parted 1.5 mm further (the lower lip's tissue lowered), so the test sees both ways."""
+    of a face with its lips parted 1.5 mm further (the lower lip's tissue lowered), so the test sees both ways, and of
+    one with its lips meeting at rest (raised by the face's gap)."""
     a = model.audio
     mel = log_mel(audio, a)                                                    # (K, n_mels)
     n_frames = int(round(len(audio) / a.sample_rate * a.fps))
@@ -70,10 +71,12 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
         silence = model.animate(torch.from_numpy(log_mel(np.zeros(a.sample_rate // 2, np.float32), a)),
                                 torch.from_numpy(template_mm), 4)["offsets"].numpy()
         lips_in = np.concatenate([offsets.numpy()[:4], silence, 0.6 * silence]).astype(np.float32)
-        wider = template_mm.copy()
+        wider, shut = template_mm.copy(), template_mm.copy()
         wider[:, 1] -= 1.5 * lip_closure.lower_weight.astype(np.float32)
+        shut[:, 1] += lip_closure.face_gap * lip_closure.lower_weight.astype(np.float32)  # lips meeting at rest
+        closure = lambda face: LipClosure(lip_closure.template, face, lip_closure.reference_gap, lip_closure.mouth_gain)
         tensors |= {"lips_in": lips_in, "lips_out": lip_closure.apply(lips_in), "template_wider_mm": wider,
-                    "lips_out_wider": LipClosure(lip_closure.template, wider, lip_closure.reference_gap, lip_closure.mouth_gain).apply(lips_in)}
+                    "lips_out_wider": closure(wider).apply(lips_in), "template_shut_mm": shut, "lips_out_shut": closure(shut).apply(lips_in)}
     for i, l in enumerate(layers):
         tensors[f"layer{i}"] = l
     tensors.update(attention)

@@ -84,3 +84,21 @@ def test_the_mouth_gain_scales_the_mouth_alone_and_a_full_closure_still_shuts(te
     # The torch version scales the same.
     o = np.concatenate([opening, closing]).astype(np.float32)
     assert np.abs(LipClosureTorch(louder).apply(torch.from_numpy(o)).numpy() - louder.apply(o)).max() < 1e-4
+
+
+def test_a_face_with_its_lips_shut_keeps_them_touching_and_opens_as_the_model_opens(template):
+    import torch
+    from talkingface.model.lip_closure import LipClosureTorch
+    face, ref_gap, rig, closing, opening = _reference(template)
+    shut_face = face.copy()
+    shut_face[:, 1] += ref_gap * rig.w_lower        # the lower lip's tissue raised until the lips meet
+    assert abs(lip_gap(shut_face[None], template)[0]) < 0.05
+    lc = LipClosure(template, shut_face, ref_gap)
+    assert len(lc.active) == 0 and len(lc.touching) > len(template.regions["lips_inner_upper"])
+    raw = lip_gap(shut_face[None] + closing, template)[0]
+    assert raw < -0.8 * ref_gap                      # as the model closes: pressed through by its whole closure
+    for scale in (1.0, 0.5, 1.4):                    # any closing, full, half or beyond, leaves them touching
+        assert abs(lip_gap(shut_face[None] + lc.apply(scale * closing), template)[0]) < 0.05
+    assert np.allclose(lc.apply(opening), opening)   # an opening is the model's
+    o = np.concatenate([closing, opening, 0.5 * closing]).astype(np.float32)
+    assert np.abs(LipClosureTorch(lc).apply(torch.from_numpy(o)).numpy() - lc.apply(o)).max() < 1e-4

@@ -14,6 +14,11 @@ it closes them fully (c = 1) they meet on any face:
 
     gap' = g - c g        c = clamp(-(du - dl) / g_ref, 0, 1)        g_ref(x) = g(x) * reference_gap / lip_gap(face)
 
+Where the face's lips already touch (g(x) <= MIN_GAP_MM: a face modelled with its mouth shut, or beyond the mouth's
+corners), g_ref is 0 and every closing motion is a full one: the model's closing there is taken out (the lips stay
+touching, gap' = g), and an opening is the model's. Without that, a closed-lip face had its lips pressed through
+each other by the whole closing motion the model learnt on parted lips (7.5 mm on /p b m/ with the shipped model).
+
 du, dl: the model's vertical offsets of the upper and lower inner-lip contours interpolated at x. reference_gap is
 how far the model itself closes: calibrated on the val split (voices and faces it was not trained on) as the gap
 at which the lips just meet on the median /p b m/ segment the front-end heard. It is not the train faces' mean
@@ -70,6 +75,7 @@ class LipClosure:
         self.ref = self.gap * (self.reference_gap / max(self.face_gap, 1e-6))  # g_ref(x)
         self.field = 0.5 * (rig.w_lower - rig.w_upper)                  # closing: the upper lip down, the lower up
         self.active = np.flatnonzero((self.field != 0) & (self.gap > MIN_GAP_MM))
+        self.touching = np.flatnonzero((self.field != 0) & (self.gap <= MIN_GAP_MM))  # the lips meet here at rest
 
     def torch(self) -> "LipClosureTorch":
         """The same as differentiable torch ops (built once)."""
@@ -81,10 +87,12 @@ class LipClosure:
         """(F, N, 3) the model's offsets in mm -> the same, the mouth's amplitude scaled, with the lips closed by the
         face's own gap."""
         o = np.array(offsets, dtype=np.float64, copy=True) * self.gain[:, None]
-        a = self.active
+        a, t = self.active, self.touching
         d = o[:, self.upper, 1] @ self.A_up[a].T - o[:, self.lower, 1] @ self.A_lo[a].T   # (F, |a|) du - dl
+        d_touching = o[:, self.upper, 1] @ self.A_up[t].T - o[:, self.lower, 1] @ self.A_lo[t].T
         c = np.clip(-d / self.ref[a], 0.0, 1.0)
         o[:, a, 1] += c * (self.gap[a] - self.ref[a]) * self.field[a]
+        o[:, t, 1] += np.minimum(d_touching, 0.0) * self.field[t]                            # no closing where they touch
         return o.astype(np.asarray(offsets).dtype)
 
 
@@ -94,11 +102,12 @@ class LipClosureTorch:
 
     def __init__(self, lc: LipClosure):
         import torch
-        a = lc.active
+        a, t = lc.active, lc.touching
         f32 = lambda x: torch.as_tensor(np.asarray(x), dtype=torch.float32)
-        self.upper, self.lower, self.active = (torch.as_tensor(i) for i in (lc.upper, lc.lower, a))
+        self.upper, self.lower, self.active, self.touching = (torch.as_tensor(i) for i in (lc.upper, lc.lower, a, t))
         self.A_up, self.A_lo = f32(lc.A_up[a].T), f32(lc.A_lo[a].T)            # (U, |a|), (L, |a|)
         self.gap, self.ref, self.field = f32(lc.gap[a]), f32(lc.ref[a]), f32(lc.field[a])
+        self.T_up, self.T_lo, self.field_touching = f32(lc.A_up[t].T), f32(lc.A_lo[t].T), f32(lc.field[t])
         self.gain = f32(lc.gain)[:, None]                                       # (N, 1)
 
     def apply(self, offsets):
@@ -107,8 +116,10 @@ class LipClosureTorch:
         y = scaled[..., 1]
         d = y[..., self.upper] @ self.A_up - y[..., self.lower] @ self.A_lo
         c = (-d / self.ref).clamp(0.0, 1.0)
+        d_touching = y[..., self.upper] @ self.T_up - y[..., self.lower] @ self.T_lo
         out = scaled.clone()
         out[..., self.active, 1] += c * (self.gap - self.ref) * self.field
+        out[..., self.touching, 1] += d_touching.clamp(max=0.0) * self.field_touching
         return out
 
 
