@@ -137,6 +137,9 @@ def test_own_subjects_are_split_by_splits_json_and_an_empty_split_says_how(tmp_p
     (tmp_path / "splits.json").write_text("{train: }")
     with pytest.raises(DatasetError, match="not valid JSON"):
         open_dataset(tmp_path, template=mesh, masks=masks)
+    (tmp_path / "splits.json").write_text(json.dumps({"train": keys[:2], "test": keys[1:]}))
+    with pytest.raises(DatasetError, match="'alice_sentence02' is in both 'train' and 'test'"):
+        open_dataset(tmp_path, template=mesh, masks=masks)
 
 
 def test_names_without_a_sentence_number_are_refused_with_the_pattern(tmp_path):

@@ -70,3 +70,29 @@ def test_the_content_encoder_per_voice():
     assert rows[1]["clips"] == 2 and (rows[1]["bilabial_segments_heard"], rows[1]["bilabial_segments"]) == (3, 4)
     md = "\n".join(art.voice_markdown(rows))
     assert "| flite:awb | 1 | 30 | 3.3% | 0 of 2 |" in md
+
+
+def test_each_hit_rate_has_its_false_alarms_and_an_empty_count_is_none():
+    # a mouth held open opens every open vowel and every /p b m/; the timed one opens none of them
+    held = art.summarise([art.clip_articulation(gap_track(lambda p, a, b: p == "M"), np.full(N, 8.0), PHONES_SEQ, FPS)])
+    assert held["pred_open_vowel_opened"] == 1.0 and held["pred_bilabial_opened"] == 1.0 and held["true_bilabial_opened"] == 0.0
+    timed = art.summarise([art.clip_articulation(gap_track(lambda p, a, b: p == "M"), gap_track(lambda p, a, b: p == "M"), PHONES_SEQ, FPS)])
+    assert timed["pred_bilabial_opened"] == 0.0
+    # a clip without /p b m/ or open vowels: rates of nothing are None, not 0%
+    none = art.summarise([art.clip_articulation(np.full(N, 8.0), np.full(N, 8.0), [("SIL", 0.0, 1.0), ("T", 1.0, 1.2)], FPS)])
+    assert none["pred_closure"] is None and none["chance_closure"] is None and none["pred_open_vowel_opened"] is None
+    assert none["pred_false_closure"] == 0.0
+
+
+def test_a_front_end_calling_p_everywhere_hears_every_bilabial_and_every_other_segment():
+    labels = np.array([PHONES.index(p) for p in ["SIL", "AA", "AA", "P", "P", "IY", "M", "T", "T", "SIL"]])
+    one_hot = lambda calls: np.eye(len(PHONES))[[PHONES.index(p) for p in calls]]
+    everywhere = one_hot(["P"] * len(labels))
+    assert art.bilabial_heard(everywhere, labels) == (2, 2)
+    assert art.bilabial_heard(everywhere, labels, others=True) == (3, 3)   # AA, IY, T: silence left out
+    right = one_hot(["SIL", "AA", "AA", "P", "P", "IY", "M", "T", "T", "SIL"])
+    assert art.bilabial_heard(right, labels) == (2, 2) and art.bilabial_heard(right, labels, others=True) == (0, 3)
+    tally = art.ContentTally(len(PHONES))
+    tally.add(everywhere, labels)
+    s = tally.summary()
+    assert s["bilabial_segments_heard"] == 1.0 and s["bilabial_false_calls"] == 1.0 and s["other_segments"] == 3

@@ -201,7 +201,17 @@ def _own_splits(root: Path, keys: list[str]) -> dict[str, list[str]]:
         if missing:
             raise DatasetError(f"{path}: {split!r} names clips that {root}/vertices_npy does not have: {', '.join(missing[:5])}"
                                + (f" and {len(missing) - 5} more" if len(missing) > 5 else ""))
+    check_disjoint(path, splits)
     return splits
+
+
+def check_disjoint(path: Path, splits: dict[str, list[str]]) -> None:
+    """A clip in two splits would be tested on what the model trained on: refused, naming the clips."""
+    seen: dict[str, str] = {}
+    for split, names in splits.items():
+        for n in names:
+            if seen.setdefault(n, split) != split:
+                raise DatasetError(f"{path}: clip {n!r} is in both {seen[n]!r} and {split!r}: a clip belongs to one split")
 
 
 def _open_corpus(root: Path) -> FaceDataset:
@@ -210,6 +220,7 @@ def _open_corpus(root: Path) -> FaceDataset:
         raise DatasetError(f"{root}/meta.json is not a {CORPUS_FORMAT} file")
     tpl = load_template(root / "template" / "template.json")
     splits = json.loads((root / "splits.json").read_text())
+    check_disjoint(root / "splits.json", splits)
     mm = MM_PER_UNIT[meta["units"]]
     return FaceDataset(root, "corpus", tpl, float(meta["fps"]), mm, splits, _read_templates_pkl(root), meta)
 

@@ -7,10 +7,12 @@ whether the lips close on /p b m/ and open on open vowels, so these count segmen
 - false alarms: other speech segments in which they close (the same criterion), so a flapping mouth cannot score;
 - chance: the hit rate of the same predicted gap shifted in time against the phones (a mouth that closes often
   but at the wrong moments scores high here too, and only the distance from chance is evidence of timing);
-- open-vowel opening: open-vowel segments in which the gap exceeds OPEN_MM at some frame;
+- open-vowel opening: open-vowel segments in which the gap exceeds OPEN_MM at some frame, with its false alarms:
+  /p b m/ segments in which it does (a mouth held open scores every open vowel);
 - gap correlation with the truth over time, and the lip amplitude ratio (predicted / true lip motion);
 - the content encoder: frame accuracy against the alignment, per-phone recall, the confusion matrix, and the
-  share of /p b m/ segments it calls bilabial at one or more of their frames.
+  share of /p b m/ segments it calls bilabial at one or more of their frames, with its false alarms: the share of
+  other speech segments it calls bilabial at one or more of theirs.
 """
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ import numpy as np
 from ..geometry.contours import lip_gap
 from ..phones import BILABIALS, LIP_GROUP_OF, OPEN_VOWELS, PHONES, SILENCE, VOWELS
 from ..template import Template
+from .subsets import labels
 
 CLOSED_MM = 1.0   # inner lips this close count as closed
 OPEN_MM = 3.0     # and this far apart as open
@@ -49,11 +52,13 @@ def speech_segments(gap: np.ndarray, phones, fps: float):
 
 def segment_counts(gap: np.ndarray, phones, fps: float) -> dict:
     """Counts of (hits, trials) for closure on bilabials, closure elsewhere in speech, and opening on open vowels."""
-    c = {"bilabial_closed": 0, "bilabial": 0, "other_closed": 0, "other": 0, "open_vowel_opened": 0, "open_vowel": 0}
+    c = {"bilabial_closed": 0, "bilabial_opened": 0, "bilabial": 0, "other_closed": 0, "other": 0, "open_vowel_opened": 0,
+         "open_vowel": 0}
     for p, a, b, g in speech_segments(gap, phones, fps):
         if p in BILABIALS:
             c["bilabial"] += 1
             c["bilabial_closed"] += int(g.min() < CLOSED_MM)
+            c["bilabial_opened"] += int(g.max() > OPEN_MM)
         else:
             c["other"] += 1
             c["other_closed"] += int(g.min() < CLOSED_MM)
@@ -91,8 +96,8 @@ def summarise(rows: list[dict]) -> dict | None:
     def total(side: str, key: str) -> int:
         return sum(r[side][key] for r in rows)
 
-    def rate(side: str, hit: str, n: str) -> float:
-        return total(side, hit) / max(total(side, n), 1)
+    def rate(side: str, hit: str, n: str) -> float | None:  # None where nothing was there to count (not "0%")
+        return total(side, hit) / total(side, n) if total(side, n) else None
     out = {"bilabial_segments": total("true", "bilabial"), "other_segments": total("true", "other"),
            "open_vowel_segments": total("true", "open_vowel"),
            "gap_corr": float(np.mean([r["gap_corr"] for r in rows])),
@@ -102,6 +107,7 @@ def summarise(rows: list[dict]) -> dict | None:
         out[f"{side}_closure"] = rate(side, "bilabial_closed", "bilabial")
         out[f"{side}_false_closure"] = rate(side, "other_closed", "other")
         out[f"{side}_open_vowel_opened"] = rate(side, "open_vowel_opened", "open_vowel")
+        out[f"{side}_bilabial_opened"] = rate(side, "bilabial_opened", "bilabial")
     return out
 
 
@@ -126,16 +132,17 @@ def called_bilabial(calls: np.ndarray, span: slice) -> bool:
     return bool(np.isin(calls[span], [PHONES.index(p) for p in BILABIALS]).any())
 
 
-def bilabial_heard(logits: np.ndarray, labels: np.ndarray) -> tuple[int, int]:
-    """(segments of /p b m/ with a bilabial argmax at one or more of their frames, segments)."""
+def bilabial_heard(logits: np.ndarray, labels: np.ndarray, others: bool = False) -> tuple[int, int]:
+    """(segments of /p b m/ with a bilabial argmax at one or more of their frames, segments); `others`: the same
+    for the other speech segments (silence left out), the false alarms. A segment: a run of frames of one label."""
     bil = np.array([PHONES.index(p) for p in BILABIALS])
     n = min(len(logits), len(labels))
-    is_bil = np.isin(labels[:n], bil)
+    counted = ~np.isin(labels[:n], [*bil, PHONES.index(SILENCE)]) if others else np.isin(labels[:n], bil)
     called = np.isin(logits[:n].argmax(-1), bil)
     hits = segs = 0
     k = 0
     while k < n:
-        if not is_bil[k]:
+        if not counted[k]:
             k += 1
             continue
         j = k
@@ -147,8 +154,9 @@ def bilabial_heard(logits: np.ndarray, labels: np.ndarray) -> tuple[int, int]:
     return hits, segs
 
 
-def content_summary(conf: np.ndarray, heard: tuple[int, int]) -> dict:
-    """Frame accuracy, per-phone recall (with frame counts), and the bilabial segment detection rate."""
+def content_summary(conf: np.ndarray, heard: tuple[int, int], false_calls: tuple[int, int] | None = None) -> dict:
+    """Frame accuracy, per-phone recall (with frame counts), and the bilabial segment detection rate (with its false
+    alarms, other speech segments called bilabial, when `false_calls` counts them)."""
     support = conf.sum(1)
     recall = {PHONES[i]: {"recall": float(conf[i, i] / support[i]), "frames": int(support[i]),
                           "mistaken_for": [PHONES[j] if j < len(PHONES) else "blank"
@@ -158,6 +166,7 @@ def content_summary(conf: np.ndarray, heard: tuple[int, int]) -> dict:
     return {"frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
             "speech_frame_accuracy": float(np.diag(conf)[speech].sum() / max(conf[speech].sum(), 1)),
             "bilabial_segments_heard": heard[0] / max(heard[1], 1), "bilabial_segments": heard[1], **accuracy_by_kind(conf),
+            **({"bilabial_false_calls": false_calls[0] / max(false_calls[1], 1), "other_segments": false_calls[1]} if false_calls else {}),
             "recall": recall, "confusion": conf.tolist()}
 
 
@@ -198,6 +207,7 @@ class ContentTally:
     def __init__(self, num_classes: int):
         self.conf = np.zeros((num_classes, num_classes), np.int64)
         self.heard = [0, 0]
+        self.false_calls = [0, 0]
         self.by_voice: dict[str, list] = {}  # voice -> [clips, confusion, heard, segments]
 
     def add(self, logits: np.ndarray, labels: np.ndarray, voice: str | None = None) -> None:
@@ -206,12 +216,15 @@ class ContentTally:
         self.conf += counts
         self.heard[0] += h
         self.heard[1] += n
+        f, m = bilabial_heard(logits, labels, others=True)
+        self.false_calls[0] += f
+        self.false_calls[1] += m
         if voice is not None:
             v = self.by_voice.setdefault(voice_family(voice), [0, np.zeros_like(self.conf), 0, 0])
             v[0], v[1], v[2], v[3] = v[0] + 1, v[1] + counts, v[2] + h, v[3] + n
 
     def summary(self) -> dict:
-        return content_summary(self.conf, tuple(self.heard))
+        return content_summary(self.conf, tuple(self.heard), tuple(self.false_calls))
 
     def voices(self) -> list[dict]:
         return voice_rows(self.by_voice)
@@ -219,22 +232,23 @@ class ContentTally:
 
 def markdown(res: dict) -> list[str]:
     """The articulation and content-encoder tables of docs/results/<model>.md."""
-    pct = lambda x: f"{100 * x:.1f}%"
+    pct = lambda x: "-" if x is None else f"{100 * x:.1f}%"
     rows = []
-    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
-        a, m = res["articulation"][name], res[name]
+    for name, label in labels(res.get("split", "test")):
+        a, m = res["articulation"].get(name), res.get(name)
         if a:
             rows.append(f"| {label} | {a['bilabial_segments']} | {pct(a['true_closure'])} / **{pct(a['pred_closure'])}** / "
                         f"{pct(a['chance_closure'])} | {pct(a['true_false_closure'])} / {pct(a['pred_false_closure'])} | "
-                        f"{pct(a['true_open_vowel_opened'])} / {pct(a['pred_open_vowel_opened'])} | {a['gap_corr']:.2f} | "
+                        f"{pct(a['true_open_vowel_opened'])} / {pct(a['pred_open_vowel_opened'])} | "
+                        f"{pct(a['true_bilabial_opened'])} / {pct(a['pred_bilabial_opened'])} | {a['gap_corr']:.2f} | "
                         f"{a['gap_std_ratio']:.2f} | {m['lip_motion_pred'] / m['lip_motion_gt']:.2f} |")
     crow = []
-    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("human", "recorded human speech")):
-        c = res["content_encoder"][name]
+    for name, label in labels(res.get("split", "test")):
+        c = res["content_encoder"].get(name)
         if c:
             rec = lambda p: pct(c["recall"][p]["recall"]) if p in c["recall"] else "-"
             crow.append(f"| {label} | {pct(c['frame_accuracy'])} | {pct(c['speech_frame_accuracy'])} | "
-                        f"{pct(c['bilabial_segments_heard'])} of {c['bilabial_segments']} | "
+                        f"{pct(c['bilabial_segments_heard'])} of {c['bilabial_segments']} | {pct(c['bilabial_false_calls'])} of {c['other_segments']} | "
                         + " / ".join(rec(p) for p in ("P", "B", "M", "F", "V")) + " |")
     return [
         "## Articulation",
@@ -243,19 +257,21 @@ def markdown(res: dict) -> list[str]:
         f"{OPEN_MM:g} mm (open vowels of {MIN_OPEN_VOWEL_S * 1000:.0f} ms or more). Chance: the model's own gap track shifted in time by",
         f"{', '.join(f'{s:g}' for s in CHANCE_SHIFTS)} of the clip against the phones. False closures: other speech segments",
         "in which the lips close (the truth closes some: neighbours of /p b m/ share their closure). Gap correlation: Pearson",
-        "over time per clip, averaged; gap std ratio and lip amplitude ratio: predicted / true.",
+        "over time per clip, averaged; gap std ratio and lip amplitude ratio: predicted / true. Opened on /p b m/: the",
+        "open vowels' false alarms (a mouth held open opens every open vowel; the truth opens some /p b m/ at their edges).",
         "",
-        "| clips | /p b m/ | /p b m/ closed: truth / **model** / chance | closed in other speech: truth / model | open vowels opened: truth / model | gap correlation | gap std ratio | lip amplitude ratio |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| clips | /p b m/ | /p b m/ closed: truth / **model** / chance | closed in other speech: truth / model | open vowels opened: truth / model | opened on /p b m/: truth / model | gap correlation | gap std ratio | lip amplitude ratio |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
         *rows,
         "",
         "## The content encoder (the stand-in for DeepSpeech)",
         "",
         "Argmax of its logits against the alignment, frame by frame (50 per second). Bilabial segments heard: /p b m/",
-        "segments called P, B or M at one or more of their frames.",
+        "segments called P, B or M at one or more of their frames; called in other speech: its false alarms, other speech",
+        "segments (silence left out) called P, B or M at one or more of theirs.",
         "",
-        "| clips | frame accuracy | speech frames | /p b m/ segments heard | recall P / B / M / F / V |",
-        "| --- | --- | --- | --- | --- |",
+        "| clips | frame accuracy | speech frames | /p b m/ segments heard | called in other speech | recall P / B / M / F / V |",
+        "| --- | --- | --- | --- | --- | --- |",
         *crow,
         "",
         *voice_markdown(res["content_encoder"].get("by_voice")),

@@ -59,9 +59,10 @@ def report(rows: list[dict]) -> list[str]:
         by[r["subject"]].append(r)
     for s, rs in sorted(by.items()):
         h = [r for r in rs if r["heard"]]
+        when_heard = (f"{np.mean([r['closed'] for r in h]):.0%} | {np.median([r['min_gap'] for r in h]):.2f}" if h
+                      else "- | -")  # none heard: nothing to average
         lines.append(f"| {s} | {rs[0]['face_gap']:.2f} | {len(rs)} | {np.mean([r['heard'] for r in rs]):.0%} | "
-                     f"{np.mean([r['closed'] for r in rs]):.0%} | {np.mean([r['closed'] for r in h]):.0%} | "
-                     f"{np.median([r['min_gap'] for r in h]):.2f} |")
+                     f"{np.mean([r['closed'] for r in rs]):.0%} | {when_heard} |")
     lines += ["", "| front-end's largest P+B+M posterior in the segment | segments | closed | median smallest gap (mm) |",
               "| --- | --- | --- | --- |"]
     for lo, hi in ((0, .3), (.3, .5), (.5, .7), (.7, .9), (.9, 1.01)):

@@ -3,7 +3,8 @@
   scripts/py -m talkingface.train.evaluate --corpus data/corpus --checkpoint runs/default/final.pt --out docs/results/default.json
 
 Clips spoken by the recorded human voice are also reported on their own ("human"), apart from the
-synthetic voices ("synthetic").
+synthetic voices ("synthetic"), and so are those of them whose sentence no clip of the train split says
+("human_unheard"; subsets.py says why).
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from ..model import head_motion as hmodel
 from ..model import lip_closure as lc
 from . import articulation as art
 from . import head_motion as hm
-from . import targets
+from . import subsets, targets
 from .data import prepare
 from .metrics import clip_metrics, eye_region, lip_region
 from .train import load_checkpoint
@@ -52,10 +53,12 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     closers = lc.Closers(t, lip_closure, mouth_gain) if lip_closure is not None else None
     regions = (lip_region(t), eye_region(t), t.regions["upper_face"])
     per_clip, artic, heads = [], [], []
-    tally = {"all": art.ContentTally(model.cfg.content_classes), "human": art.ContentTally(model.cfg.content_classes)}
+    tally = {part: art.ContentTally(model.cfg.content_classes) for part in ("all", "human", "human_unheard")}
     keys = ds.keys(split)
+    heard_sentences, said = set(subsets.sentences(ds, "train").values()), subsets.sentences(ds, split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
+        tags = {"source": c.source, "sentence_heard": said.get(key) in heard_sentences}
         mel = torch.from_numpy(c.mel)
         with torch.no_grad():
             heard = model.content(mel[None])[0]                               # (Kc, D): once, for the face and the tally
@@ -71,26 +74,27 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
             mean_pose = pred_pose
             for k in range(head_draws):
                 drawn = hmodel.compose(mean_pose, head.sample(feats, draw_seed(seed, i, k)), head.pivot_mm)
-                heads.append(hm.clip_head_motion(c.pose, drawn, env) | {"source": c.source, "draw": k})
+                heads.append(hm.clip_head_motion(c.pose, drawn, env) | tags | {"draw": k})
                 if k == 0:
                     pred_pose = drawn
             pred_posed = apply_pose_np(pred_unposed, pred_pose)
         else:
-            heads.append(hm.clip_head_motion(c.pose, pred_pose, env) | {"source": c.source, "draw": 0})
+            heads.append(hm.clip_head_motion(c.pose, pred_pose, env) | tags | {"draw": 0})
         gt_posed = apply_pose_np(c.vertices, c.pose)
         m = clip_metrics(c.vertices, pred_unposed, gt_posed, pred_posed, c.template, c.pose, pred_pose, regions)
-        m.update(key=key, source=c.source, frames=c.num_frames)
+        m.update(key=key, frames=c.num_frames, **tags)
         per_clip.append(m)
         a = art.clip_articulation(art.inner_lip_gap(c.vertices, t), art.inner_lip_gap(pred_unposed, t), c.segments, ds.fps)
-        artic.append(a | {"source": c.source})
+        artic.append(a | tags)
         logits = heard.numpy()
         labels = c.phones[:: model.cfg.content_stride]
         tally["all"].add(logits, labels, c.voice)
-        if c.source == "human":
-            tally["human"].add(logits, labels)
+        for part in ("human", "human_unheard"):
+            if subsets.member(tags, part):
+                tally[part].add(logits, labels)
         if progress:
             progress(i + 1, len(keys))
-    names = [k for k in per_clip[0] if k not in ("key", "source", "frames")]
+    names = [k for k in per_clip[0] if k not in ("key", "source", "frames", "sentence_heard")]
 
     def summary(rows):
         if not rows:
@@ -99,19 +103,18 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
         w = np.array([r["frames"] for r in rows], dtype=np.float64)
         return {n: float(np.average([r[n] for r in rows], weights=w if n.startswith("E_") or n.startswith("pose_error") else None))
                 for n in names} | {"clips": len(rows)}
-    human = [r for r in artic if r["source"] == "human"]
-    articulation = {"all": art.summarise(artic), "synthetic": art.summarise([r for r in artic if r["source"] != "human"]),
-                    "human": art.summarise(human)}
-    content = {"all": tally["all"].summary(), "human": tally["human"].summary() if human else None,
-               "by_voice": tally["all"].voices()}
+    parts = [name for name, _ in subsets.PARTS]
+    of = lambda rows, part: [r for r in rows if subsets.member(r, part)]
+    articulation = {part: art.summarise(of(artic, part)) for part in parts}
+    content = {part: tally[part].summary() if part == "all" or of(artic, part) else None for part in ("all", "human", "human_unheard")}
+    content["by_voice"] = tally["all"].voices()
     if head_rows is not None:  # the per-clip speeds, for the Fig. 4 plot
         head_rows.extend(heads)
-    head = {"all": hm.summarise_draws(heads), "synthetic": hm.summarise_draws([r for r in heads if r["source"] != "human"]),
-            "human": hm.summarise_draws([r for r in heads if r["source"] == "human"])}
+    head = {part: hm.summarise_draws(of(heads, part)) for part in parts}
     # A dataset without phone alignments (VOCASET) or head poses: what those measures are taken against, said with them.
     missing = [what for what, folder in (("phone alignments", "alignments"), ("head poses", "poses_npy")) if not (ds.root / folder).is_dir()]
-    return {"missing": missing, "all": summary(per_clip), "synthetic": summary([r for r in per_clip if r["source"] != "human"]),
-            "human": summary([r for r in per_clip if r["source"] == "human"]), "silence": silence_probe(model, t, lip_closure, mouth_gain),
+    return {"missing": missing, **{part: summary(of(per_clip, part)) for part in parts},
+            "silence": silence_probe(model, t, lip_closure, mouth_gain),
             "articulation": articulation, "content_encoder": content, "head_motion": head, "per_clip": per_clip}
 
 
@@ -214,11 +217,12 @@ def main(argv=None) -> int:
           f"FDD {a['FDD']:.4f}  AFDD {a['AFDD']:.4f}  pose {a['pose_error_deg']:.2f} deg  jitter {a['pose_jitter_deg']:.3f} deg"
           + (f"  | human E_vl {res['human']['E_vl']:.3f} mm" if res["human"] else ""))
     ar, ce = res["articulation"]["all"], res["content_encoder"]["all"]
-    print(f"/p b m/ closed {100 * ar['pred_closure']:.1f}% (truth {100 * ar['true_closure']:.1f}%, chance "
-          f"{100 * ar['chance_closure']:.1f}%), closed elsewhere {100 * ar['pred_false_closure']:.1f}% "
-          f"(truth {100 * ar['true_false_closure']:.1f}%), open vowels opened {100 * ar['pred_open_vowel_opened']:.1f}%, "
-          f"gap correlation {ar['gap_corr']:.2f}; content encoder frame accuracy {100 * ce['frame_accuracy']:.1f}%, "
-          f"/p b m/ heard {100 * ce['bilabial_segments_heard']:.1f}%")
+    pct = lambda x: "-" if x is None else f"{100 * x:.1f}%"  # None: nothing of the kind in the split
+    print(f"/p b m/ closed {pct(ar['pred_closure'])} (truth {pct(ar['true_closure'])}, chance {pct(ar['chance_closure'])}), "
+          f"closed elsewhere {pct(ar['pred_false_closure'])} (truth {pct(ar['true_false_closure'])}), open vowels opened "
+          f"{pct(ar['pred_open_vowel_opened'])} (on /p b m/ {pct(ar['pred_bilabial_opened'])}), gap correlation {ar['gap_corr']:.2f}; "
+          f"content encoder frame accuracy {pct(ce['frame_accuracy'])}, /p b m/ heard {pct(ce['bilabial_segments_heard'])} "
+          f"(in other speech {pct(ce['bilabial_false_calls'])})")
     if args.out:
         out = Path(args.out)
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -241,8 +245,8 @@ def missing_notes(res: dict) -> list[str]:
 def markdown(res: dict, args, ck: dict, head_plot: str) -> str:
     cfg = ck["model_config"]
     rows = []
-    for name, label in (("all", f"all {args.split} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
-        r = res[name]
+    for name, label in subsets.labels(args.split):
+        r = res.get(name)
         if r:
             rows.append(f"| {label} | {r['clips']} | {r['E_vl']:.3f} | {r['E_ve']:.3f} | {r['E_vl_posed']:.3f} | {r['FDD']:.4f} | "
                         f"{r['AFDD']:.4f} | {r['pose_error_deg']:.2f} | {r['pose_jitter_deg']:.3f} ({r['pose_jitter_gt_deg']:.3f}) | "

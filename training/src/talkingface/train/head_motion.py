@@ -19,6 +19,7 @@ import numpy as np
 
 from ..geometry.pose import pose_step_degrees
 from .metrics import jitter_deg
+from .subsets import labels
 
 AXES = ("pitch", "yaw", "roll")  # rotation about x, y, z (axis-angle components, template axes)
 
@@ -119,8 +120,8 @@ def summarise_draws(rows: list[dict]) -> dict | None:
 
 def markdown(res: dict, plot_name: str) -> list[str]:
     rows = []
-    for name, label in (("all", f"all {res.get('split', 'test')} clips"), ("synthetic", "synthetic voices"), ("human", "recorded human speech")):
-        h = res["head_motion"][name]
+    for name, label in labels(res.get("split", "test")):
+        h = res["head_motion"].get(name)
         if h:
             ax, each = h["spread_ratio_axes"], h.get("spread_ratio_draws") or []
             spread_range = f"{min(each):.2f} - {max(each):.2f}" if len(each) > 1 else "-"

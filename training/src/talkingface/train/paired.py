@@ -64,7 +64,7 @@ def mcnemar(a: np.ndarray, b: np.ndarray) -> dict:
 def d_prime(hit: float, false_alarm: float, n_hit: int, n_false: int) -> float:
     """z(hit) - z(false alarm), each rate kept half a trial from 0 and 1."""
     z = NormalDist().inv_cdf
-    clamp = lambda r, n: min(max(r, 0.5 / n), 1 - 0.5 / n)
+    clamp = lambda r, n: min(max(r, 0.5 / max(n, 1)), 1 - 0.5 / max(n, 1))  # no trials (a subset without /p b m/): 0.5
     return z(clamp(hit, n_hit)) - z(clamp(false_alarm, n_false))
 
 
