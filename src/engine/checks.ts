@@ -56,8 +56,11 @@ export function checkedLayer(layer: unknown, layers: number): number {
   return layer;
 }
 
-/** The head motion's seed: an integer, or null (the pose head's mean pose alone). */
+/** The head motion's seed: an integer JavaScript holds exactly (beyond 2^53 it is rounded, and the motion would not be
+ * Python's for the same seed), or null (the pose head's mean pose alone). */
 export function checkedSeed(seed: unknown): number | null {
-  if (seed !== null && !Number.isInteger(seed)) throw new RangeError(`headMotionSeed must be an integer or null, not ${seed}`);
+  if (seed !== null && !Number.isSafeInteger(seed)) {
+    throw new RangeError(`headMotionSeed must be an integer from -(2^53 - 1) to 2^53 - 1, or null, not ${String(seed)}`);
+  }
   return seed as number | null;
 }

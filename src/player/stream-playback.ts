@@ -231,7 +231,9 @@ export class StreamPlayback {
     if (at && this.computed > 0) {
       const f = Math.floor((at.sample / this.rate) * this.fps);
       const late = f >= this.computed;
-      const shown = late ? this.computed - 1 : f;
+      // Never before the oldest frame kept: the heard clock steps back when the output's latency grows mid-stream
+      // (headphones switched on), further than the frames forget() keeps.
+      const shown = late ? this.computed - 1 : Math.max(f, this.chunks[0].first);
       const resting = at.quietFor > REST_AFTER_SECONDS;
       if (shown !== this.shown || resting !== this.resting) {
         if (late && shown !== this.shown) this.lateFrames++;

@@ -11,7 +11,7 @@
  * state carried between chunks is the process's last two values. The residual turns the head about the neck
  * pivot p: R' = R_r R, t' = R_r (t - p) + p.
  */
-import { f32, type Tensor } from '../model/safetensors';
+import { f32, SafetensorsError, type Tensor } from '../model/safetensors';
 import type { ModelConstants } from '../model/manifest';
 
 export interface HeadMotionParams {
@@ -36,8 +36,16 @@ export interface HeadMotionState {
 /** The head-motion tensors of gava.safetensors (`head_motion.*`), or null for a model exported without them. */
 export function headMotionParams(t: Map<string, Tensor>, m: ModelConstants): HeadMotionParams | null {
   if (!t.has('head_motion.ar')) return null;
+  const ar = f32(t, 'head_motion.ar', [3, 2]);
+  for (let k = 0; k < 3; k++) {
+    const [a1, a2] = [ar[2 * k], ar[2 * k + 1]];
+    // A process that does not settle starts from an infinite spread or grows without bound: NaN poses, no head.
+    if (!(Math.abs(a2) < 1 && a2 + a1 < 1 && a2 - a1 < 1)) {
+      throw new SafetensorsError(`head_motion.ar: axis ${k}'s AR(2) (${a1}, ${a2}) does not settle (|a2| < 1, a2 +- a1 < 1): re-fit the head's motion`);
+    }
+  }
   return {
-    ar: f32(t, 'head_motion.ar', [3, 2]),
+    ar,
     sigmaW: f32(t, 'head_motion.sigma_w', [3, m.d_model]),
     sigmaB: f32(t, 'head_motion.sigma_b', [3]),
     sigmaMean: f32(t, 'head_motion.sigma_mean', [3]),

@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedWorkers } from '../../../src/engine/checks';
+import { checkedBackend, checkedChunk, checkedFrame, checkedLayer, checkedSamples, checkedSeed, checkedWorkers } from '../../../src/engine/checks';
 
 describe('the engine\'s argument checks', () => {
   it('samples: a Float32Array of finite audio, else an error that names what is wrong', () => {
@@ -35,6 +35,13 @@ describe('the engine\'s argument checks', () => {
     expect(checkedLayer(0, 3)).toBe(0);
     expect(checkedLayer(2, 3)).toBe(2);
     for (const bad of [3, -1, 1.5, NaN, '2']) expect(() => checkedLayer(bad, 3)).toThrow(/layer must be a whole number from 0 to 2 \(the decoder's layers count from 0\)/);
+  });
+});
+
+describe('the head motion\'s seed', () => {
+  it('is an integer JavaScript holds exactly (beyond 2^53 the browser and Python would draw different motion), or null', () => {
+    for (const ok of [0, -7, 2 ** 32 + 5, Number.MAX_SAFE_INTEGER, null]) expect(checkedSeed(ok)).toBe(ok);
+    for (const bad of [2 ** 60, -(2 ** 53), 1.5, NaN, '3', undefined]) expect(() => checkedSeed(bad)).toThrow(/headMotionSeed must be an integer from/);
   });
 });
 

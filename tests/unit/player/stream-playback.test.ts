@@ -132,6 +132,27 @@ describe('StreamPlayback', () => {
     p.stop();
   });
 
+  it('shows the oldest frame it kept when the output\'s latency grows mid-stream (headphones switched on), and draws on', () => {
+    const { player, shown } = stage();
+    const events: number[] = [];
+    const p = new StreamPlayback(player, RATE, FPS, 0.3, { onFrame: (f, fr, at) => events.push(fr.unposed[at * 3]) });
+    for (let k = 0; k < 40; k++) { // 4 s in pieces of 0.1 s, one frame each
+      p.write(new Float32Array(RATE / FPS));
+      p.frames(k, frames(k, 1));
+    }
+    drawAt(3.3); // heard 3.0 s in: frame 30; the frames more than LIVE_REST_FRAMES before it are forgotten
+    expect(shown.at(-1)).toBe(30);
+    (FakeContext.last as unknown as { outputLatency: number }).outputLatency = 2; // heard now: frame 10, long forgotten
+    drawAt(3.31);
+    const oldest = shown.at(-1)!;
+    expect(oldest).toBeGreaterThan(10);   // the oldest frame kept, not one out of its chunk
+    expect(oldest).toBeLessThanOrEqual(30);
+    expect(events.at(-1)).toBe(oldest);   // and what onFrame reports
+    drawAt(5.52); // 3.22 s into the stream heard: the clock caught up, the face follows it
+    expect(shown.at(-1)).toBe(32);
+    p.stop();
+  });
+
   it('never cuts a delay the page chose longer than the growth\'s ceiling (MAX_DELAY)', () => {
     const { player } = stage();
     const told: number[] = [];

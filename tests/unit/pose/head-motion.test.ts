@@ -17,6 +17,17 @@ describe.skipIf(!manifest.head_motion)('the head\'s own motion', () => {
   const frames = manifest.fixtures.frames;
   const poseToken = f32(fx, 'pose_token');
 
+  it('refuses a process that does not settle (its poses would be NaN), naming the axis', () => {
+    const tensors = parseSafetensors(buf(manifest.files.decoder_weights)).tensors;
+    for (const ar of [[1.5, -0.5], [1.2, -0.1], [0.2, -1]]) {
+      const bad = Float32Array.from(f32(tensors, 'head_motion.ar'));
+      bad.set(ar, 2);
+      const t = new Map(tensors).set('head_motion.ar', { dtype: 'F32', shape: [3, 2], data: bad });
+      expect(() => headMotionParams(t, m)).toThrow(/axis 1's AR\(2\) .* does not settle/);
+    }
+    expect(headMotionParams(tensors, m)).not.toBeNull(); // the shipped one settles (0.988 to 0.993)
+  });
+
   it('draws the same residuals as the Python sampler for seed 0, and turns the poses the same way', () => {
     const residual = head.residuals(head.start(0), 0, poseToken, frames);
     expect(maxAbsDiff(residual, f32(fx, 'head_residual'))).toBeLessThan(1e-4); // degrees; the fixture is float32

@@ -1,5 +1,6 @@
 """The head's own motion (model/head_motion.py): the speech read-out finds what the speech carries, the process
 the rest, the gain the truth's spread; a seed draws the same motion; an earlier checkpoint's dict still loads."""
+import pytest
 import numpy as np
 
 from talkingface.model import head_motion as hmod
@@ -86,3 +87,13 @@ def test_motion_stats_measures_spread_speed_and_jitter():
     assert abs(st["jitter"] - 2 / np.pi * w * w) < 1e-4
     st2 = hmod.motion_stats([3 * x])
     assert all(abs(st2[k] - 3 * st[k]) < 1e-9 for k in st)
+
+
+def test_a_fit_that_would_not_settle_is_refused():
+    from talkingface.model.head_motion import fit_ar2
+    rng = np.random.default_rng(0)
+    growing = np.cumprod(np.full((200, 3), 1.02), 0) + rng.normal(0, 0.01, (200, 3))  # grows 2% a frame
+    with pytest.raises(ValueError, match="does not settle"):
+        fit_ar2([growing])
+    ar, _ = fit_ar2([rng.normal(0, 1, (200, 3))])  # noise settles
+    assert np.abs(ar).max() < 0.5

@@ -149,6 +149,8 @@ def fit_ar2(series: list[np.ndarray]) -> tuple[np.ndarray, list[np.ndarray]]:
         X = np.concatenate([np.stack([r[1:-1, k], r[:-2, k]], 1) for r in series])
         y = np.concatenate([r[2:, k] for r in series])
         ar[k] = np.linalg.lstsq(X, y, rcond=None)[0]
+    if not all(abs(a2) < 1 and a2 + a1 < 1 and a2 - a1 < 1 for a1, a2 in ar):  # else its spread grows without bound
+        raise ValueError(f"the head's fitted AR(2) {ar.round(4).tolist()} does not settle (|a2| < 1, a2 +- a1 < 1 per axis)")
     innov = [r[2:] - r[1:-1] * ar[:, 0] - r[:-2] * ar[:, 1] for r in series]
     return ar, innov
 
