@@ -200,6 +200,7 @@ fn heads(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) li
     for (var k = 0u; k < D; k = k + 1u) { v = v + weights[pose_w + i * D + k] * hbuf[k]; }
     var bound = params.max_translation;
     if (i < 3u) { bound = params.max_rotation; }
-    result[params.frames * params.n * 3u + frame * 6u + i] = bound * tanh(v);
+    // tanh is undefined past |x| = 88.7 in WGSL (NaN on some GPUs); at 15 it is 1 in f32, as Math.tanh saturates.
+    result[params.frames * params.n * 3u + frame * 6u + i] = bound * tanh(clamp(v, -15.0, 15.0));
   }
 }

@@ -65,6 +65,9 @@ export class DecoderPool {
             clearTimeout(timer);
             kernels.push(e.data.kernel);
             resolve();
+          } else if (e.data?.type === 'error') { // its decoder could not be built: at once, and why
+            clearTimeout(timer);
+            reject(new Error(`decoder worker could not start: ${e.data.message}`));
           }
         };
         w.onerror = (e) => {

@@ -14,7 +14,7 @@
  */
 import type { ModelConstants } from '../model/manifest';
 import type { Adjacency } from '../template/mesh-topology';
-import { keyLists, vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from './reference';
+import { checkFrames, keyLists, vertexEmbeddingMismatch, type DecodeResult, type DecoderWeights } from './reference';
 import { geluInPlace, jsKernel, matmulRows, type DecoderKernel, type PackedWeight } from './decoder-kernels';
 import { simdModule, SimdKernel } from './simd-kernel';
 
@@ -120,6 +120,7 @@ export class FastDecoder {
   /** tokens (F x N x d), poseToken (F x d) -> displacement (F x N x 3, mm) and pose (F x 6) per frame. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number): DecodeResult {
     const { n, d } = this;
+    checkFrames('FastDecoder.decode', frames, [['tokens', tokens, n * d], ['poseToken', poseToken, d]]);
     return this.frames(poseToken, frames, (f) => this.x.set(tokens.subarray(f * n * d, (f + 1) * n * d), 0));
   }
 
@@ -128,6 +129,7 @@ export class FastDecoder {
    * tokens are made here, in the decoder's arithmetic: localOut(gelu(a + e_j)) + g (reference.ts vertexTokens).
    */
   decodeLatents(latents: Float32Array, poseToken: Float32Array, frames: number): DecodeResult {
+    checkFrames('FastDecoder.decodeLatents', frames, [['latents', latents, 2 * this.d], ['poseToken', poseToken, this.d]]);
     return this.frames(poseToken, frames, (f) => this.vertexTokensOf(latents, f));
   }
 

@@ -36,6 +36,27 @@ export function packWeights(w: DecoderWeights): { data: Float32Array; layerBases
   return { data, layerBases, finalBase };
 }
 
+/** The device limits a decoder is sized by (a GPUDevice's `limits` has them). */
+export type GpuLimits = Pick<GPUSupportedLimits, 'maxStorageBufferBindingSize' | 'maxBufferSize' | 'maxComputeWorkgroupsPerDimension'>;
+
+/**
+ * How many frames one batch may hold on a device with `limits` (at most `wanted`): its largest buffer (q, k and v of
+ * every token of every frame) within one binding, its frames within one dispatch. A mesh, a model or its weights too
+ * large for the device at all is an Error that says which limit: past a limit WebGPU only reports an error to the
+ * console, and the batch would read back zeros.
+ */
+export function gpuFramesWithin(limits: GpuLimits, vertices: number, d: number, weightFloats: number, wanted: number): number {
+  const binding = Math.min(limits.maxStorageBufferBindingSize, limits.maxBufferSize);
+  const tokens = vertices + 1;
+  const perFrame = Math.max(tokens * 3 * d * 4, (vertices * 3 + 6) * 4);
+  const why = tokens > limits.maxComputeWorkgroupsPerDimension
+    ? `${tokens} tokens exceed this device's ${limits.maxComputeWorkgroupsPerDimension} workgroups per dispatch`
+    : weightFloats * 4 > binding ? `the decoder's weights (${weightFloats * 4} bytes) exceed this device's ${binding}-byte storage binding`
+      : perFrame > binding ? `one frame of ${tokens} tokens of ${d} (${perFrame} bytes) exceeds this device's ${binding}-byte storage binding` : '';
+  if (why) throw new Error(`GpuDecoder: ${why}`);
+  return Math.max(1, Math.min(wanted, Math.floor(binding / perFrame), limits.maxComputeWorkgroupsPerDimension));
+}
+
 export class GpuDecoder {
   private readonly pipelines: Record<'vertex_tokens' | 'ln_qkv' | 'attend' | 'out_ffn' | 'heads', GPUComputePipeline>;
   private readonly bindGroups: GPUBindGroup[]; // one per layer, then one for the heads
@@ -50,6 +71,8 @@ export class GpuDecoder {
   private readonly n: number;
   private readonly t: number;
   private readonly d: number;
+  /** Frames one batch holds: as many as asked for, or fewer where the device's limits say so (gpuFramesWithin). */
+  readonly maxFrames: number;
   private busy: Promise<unknown> = Promise.resolve();
 
   constructor(
@@ -57,7 +80,7 @@ export class GpuDecoder {
     weights: DecoderWeights,
     adjacency: Adjacency,
     readonly m: ModelConstants,
-    readonly maxFrames: number,
+    framesWanted: number,
   ) {
     const d = m.d_model;
     if ((d & (d - 1)) !== 0 || d > 256) throw new Error(`GpuDecoder: d_model ${d} must be a power of two up to 256`);
@@ -65,6 +88,8 @@ export class GpuDecoder {
     this.n = adjacency.offsets.length - 1;
     this.t = this.n + 1;
     this.d = d;
+    const packed = packWeights(weights);
+    const maxFrames = (this.maxFrames = gpuFramesWithin(device.limits, this.n, d, packed.data.length, framesWanted));
     const storage = (label: string, bytes: number, usage = 0) => {
       const b = device.createBuffer({ label, size: Math.max(16, bytes), usage: GPUBufferUsage.STORAGE | GPUBufferUsage.COPY_DST | usage });
       this.buffers.push(b);
@@ -82,7 +107,6 @@ export class GpuDecoder {
     this.noTokens = vertexEmbeddingMismatch(weights, this.n, d);
     const offsets = upload('GpuDecoder.csrOffsets', adjacency.offsets);
     const indices = upload('GpuDecoder.csrIndices', adjacency.indices.length ? adjacency.indices : new Uint32Array(1));
-    const packed = packWeights(weights);
     const w = upload('GpuDecoder.weights', packed.data);
     const resultBytes = (maxFrames * this.n * 3 + maxFrames * 6) * 4;
     this.result = storage('GpuDecoder.result', resultBytes, GPUBufferUsage.COPY_SRC);
@@ -151,12 +175,36 @@ export class GpuDecoder {
 
   /** One batch, from vertex tokens or (tokens null) from latents. */
   private async run(tokens: Float32Array | null, latents: Float32Array | null, poseToken: Float32Array, frames: number): Promise<DecodeResult> {
-    const { device, n, t, d } = this;
+    const { device, n, d } = this;
     if (frames > this.maxFrames) throw new RangeError(`GpuDecoder: ${frames} frames exceed the ${this.maxFrames} it was built for`);
     if ((tokens && tokens.length !== frames * n * d) || (latents && latents.length !== frames * 2 * d) || poseToken.length !== frames * d) {
       throw new RangeError('GpuDecoder: token arrays do not match the frame count');
     }
     if (latents && this.noTokens) throw new Error(`GpuDecoder: ${this.noTokens}`);
+    // Validation and memory errors only reach the console unless a scope catches them: the batch would read back
+    // zeros. Caught, they fail it, and the engine carries on with the CPU decoder.
+    device.pushErrorScope('out-of-memory');
+    device.pushErrorScope('validation');
+    let thrown: unknown = null;
+    try {
+      this.upload(tokens, latents, poseToken, frames);
+      this.encode(frames, latents !== null);
+    } catch (e) {
+      thrown = e; // thrown once the scopes are popped: they must be, whatever happens
+    }
+    const error = (await Promise.all([device.popErrorScope(), device.popErrorScope()])).find((e) => e);
+    if (error) throw new Error(`GpuDecoder: ${error.message}`);
+    if (thrown) throw thrown;
+    const offsetBytes = frames * this.n * 3 * 4;
+    await this.readback.mapAsync(GPUMapMode.READ, 0, offsetBytes + frames * 6 * 4);
+    const out = new Float32Array(this.readback.getMappedRange(0, offsetBytes + frames * 6 * 4).slice(0));
+    this.readback.unmap();
+    return { offsets: out.subarray(0, frames * this.n * 3), pose: out.subarray(frames * this.n * 3) };
+  }
+
+  /** Write one batch's inputs and each pass's uniforms. */
+  private upload(tokens: Float32Array | null, latents: Float32Array | null, poseToken: Float32Array, frames: number): void {
+    const { device, n, t, d } = this;
     if (tokens) {
       const xs = new Float32Array(frames * t * d);
       for (let f = 0; f < frames; f++) {
@@ -179,10 +227,15 @@ export class GpuDecoder {
       f32[6] = this.m.max_translation_mm;
       device.queue.writeBuffer(u, 0, params);
     }
+  }
+
+  /** Encode and submit one batch's passes and its copy to the readback buffer. */
+  private encode(frames: number, fromLatents: boolean): void {
+    const { device, n, t } = this;
     const encoder = device.createCommandEncoder({ label: 'GpuDecoder.encoder' });
     const pass = encoder.beginComputePass({ label: 'GpuDecoder.pass' });
     const layers = this.uniforms.length - 1;
-    if (latents) { // the heads' uniforms hold final_base, where the vertex tokens' weights begin
+    if (fromLatents) { // the heads' uniforms hold final_base, where the vertex tokens' weights begin
       pass.setBindGroup(0, this.bindGroups[layers]);
       pass.setPipeline(this.pipelines.vertex_tokens);
       pass.dispatchWorkgroups(n, frames);
@@ -203,10 +256,6 @@ export class GpuDecoder {
     // The shader writes the poses right after this call's offsets.
     encoder.copyBufferToBuffer(this.result, offsetBytes, this.readback, offsetBytes, frames * 6 * 4);
     device.queue.submit([encoder.finish()]);
-    await this.readback.mapAsync(GPUMapMode.READ, 0, offsetBytes + frames * 6 * 4);
-    const out = new Float32Array(this.readback.getMappedRange(0, offsetBytes + frames * 6 * 4).slice(0));
-    this.readback.unmap();
-    return { offsets: out.subarray(0, frames * n * 3), pose: out.subarray(frames * n * 3) };
   }
 
   destroy(): void {

@@ -162,6 +162,15 @@ export interface AttentionMaps {
   keys: Int32Array;
 }
 
+/** At least `frames` frames in each array, `per` floats a frame (the first are read): else a RangeError naming the
+ * short one (it decoded NaN, silently). */
+export function checkFrames(who: string, frames: number, arrays: [string, Float32Array, number][]): void {
+  if (!Number.isInteger(frames) || frames < 0) throw new RangeError(`${who}: frames must be a whole number, not ${frames}`);
+  for (const [name, a, per] of arrays) {
+    if (a.length < frames * per) throw new RangeError(`${who}: ${name} holds ${a.length} floats, fewer than ${frames} frames of ${per}`);
+  }
+}
+
 export class ReferenceDecoder {
   readonly n: number;
   private readonly d: number;
@@ -196,7 +205,7 @@ export class ReferenceDecoder {
     const { keyStart, keys } = keyLists(this.adjacency, false);
     this.capture = { layer, poseToken: new Float32Array(n + 1), vertexWeights: new Float32Array(keys.length), keyStart, keys };
     try {
-      this.decode(tokens, poseToken, 1);
+      this.decode(tokens.subarray(0, n * this.d), poseToken.subarray(0, this.d), 1);
       return this.capture;
     } finally {
       this.capture = null;
@@ -206,6 +215,7 @@ export class ReferenceDecoder {
   /** tokens (F x N x d), poseToken (F x d) -> displacement and pose per frame. `layerOut` receives each layer's tokens of frame 0. */
   decode(tokens: Float32Array, poseToken: Float32Array, frames: number, layerOut?: Float32Array[]): DecodeResult {
     const { n, d } = this;
+    checkFrames('ReferenceDecoder.decode', frames, [['tokens', tokens, n * d], ['poseToken', poseToken, d]]);
     const offsets = new Float32Array(frames * n * 3);
     const pose = new Float32Array(frames * 6);
     for (let f = 0; f < frames; f++) {

@@ -60,7 +60,7 @@ export class DecoderBackends {
           gpu = new GpuDecoder(await requestSharedDevice(), weights, adjacency, m, gpuFrames);
           reason = `WebGPU: ${support.description}`;
         } catch (e) {
-          reason = `WebGPU device request failed (${(e as Error).message}); using the CPU decoder`;
+          reason = `WebGPU could not be used (${(e as Error).message}); using the CPU decoder`;
         }
       } else {
         reason = `no WebGPU (${support.description}); using the CPU decoder`;

@@ -165,6 +165,7 @@ export async function decodeTemplate(header: unknown, binary: ArrayBuffer): Prom
   checkIndices(triangles, n, 'triangles');
   checkMesh(`template "${h.id}"`, h.units, positions, triangles);
   checkIndices(indices, n, 'adjacencyIndices');
+  checkAdjacency(`template "${h.id}"`, offsets, indices);
   const regions = {} as Regions;
   for (const [name, list] of Object.entries(h.regions)) {
     const idx = Uint32Array.from(list);
@@ -254,6 +255,34 @@ function checkMesh(what: string, units: unknown, positions: Float32Array, triang
 function checkIndices(a: Uint32Array, n: number, what: string): void {
   for (let i = 0; i < a.length; i++) {
     if (a[i] >= n) throw new TemplateFormatError(`${what}: index ${a[i]} is out of range for ${n} vertices`);
+  }
+}
+
+/**
+ * The 1-rings in CSR form as the attention reads them: offsets from 0, never decreasing (a list read backwards made
+ * the three decoders disagree, and the shader loop run for ever), each list ascending without the vertex itself, and
+ * symmetric (u in v's ring when v is in u's).
+ */
+function checkAdjacency(what: string, offsets: Uint32Array, indices: Uint32Array): void {
+  const n = offsets.length - 1;
+  if (offsets[0] !== 0) throw new TemplateFormatError(`${what}: adjacencyOffsets must start at 0, not ${offsets[0]}`);
+  const has = (v: number, u: number): boolean => {
+    let lo = offsets[v], hi = offsets[v + 1] - 1;
+    while (lo <= hi) {
+      const mid = (lo + hi) >> 1;
+      if (indices[mid] === u) return true;
+      if (indices[mid] < u) lo = mid + 1;
+      else hi = mid - 1;
+    }
+    return false;
+  };
+  for (let v = 0; v < n; v++) {
+    if (offsets[v + 1] < offsets[v]) throw new TemplateFormatError(`${what}: adjacencyOffsets decrease at vertex ${v}`);
+    for (let k = offsets[v]; k < offsets[v + 1]; k++) {
+      const u = indices[k];
+      const why = u === v ? 'lists itself' : k > offsets[v] && u <= indices[k - 1] ? 'is not in ascending order' : !has(u, v) ? `lists ${u}, whose ring lacks ${v}` : '';
+      if (why) throw new TemplateFormatError(`${what}: the 1-ring of vertex ${v} ${why} (adjacencyIndices: symmetric, no self loops, ascending)`);
+    }
   }
 }
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from talkingface.paths import TEMPLATE_DIR
-from talkingface.template import REQUIRED_REGIONS, TemplateFormatError, build_adjacency, load_template
+from talkingface.template import REQUIRED_REGIONS, TemplateFormatError, build_adjacency, check_adjacency, load_template
 
 
 def test_shipped_template_reads_in_python(template):
@@ -26,6 +26,22 @@ def test_python_adjacency_equals_the_one_typescript_wrote(template):
     edges = {tuple(e) for e in template.edges().tolist()}
     assert all((b, a) in edges for a, b in edges)
     assert all(a != b for a, b in edges)
+
+
+def test_rings_the_attention_cannot_read_are_refused(template):
+    import dataclasses
+    off, idx, n = template.adj_offsets, template.adj_indices, template.num_vertices
+    check_adjacency(template)
+
+    def broken(edit, match):
+        o, i = off.copy(), idx.copy()
+        edit(o, i)
+        with pytest.raises(TemplateFormatError, match=match):
+            check_adjacency(dataclasses.replace(template, adj_offsets=o, adj_indices=i))
+    broken(lambda o, i: o.__setitem__(2, o[1] - 1), "must rise from 0")
+    broken(lambda o, i: i.__setitem__(off[0], 0), "lists itself")
+    broken(lambda o, i: i.__setitem__(slice(off[0], off[0] + 2), i[off[0]:off[0] + 2][::-1].copy()), "not in ascending order")
+    broken(lambda o, i: i.__setitem__(off[1] - 1, n - 1), "whose ring lacks it")
 
 
 def test_corrupt_binary_is_reported(tmp_path):

@@ -56,6 +56,19 @@ describe('the fast decoder vs the PyTorch fixture', () => {
     expect(() => mismatched.decodeLatents(latents, poseTok, frames)).toThrow(`10 vertices, the template ${template.adjacency.offsets.length - 1}`);
   });
 
+  it('refuses arrays shorter than the frames asked for, naming the short one (they decoded NaN)', async () => {
+    const { m, template, weights, decoder, frames, poseTok } = await exportedDecoder('js');
+    const tokens = f32(fx, 'tokens');
+    const latents = f32(fx, 'hierarchical_latents');
+    const d = m.d_model;
+    expect(() => decoder.decode(tokens, poseTok, frames + 1)).toThrow(/FastDecoder.decode: tokens holds \d+ floats, fewer than 3 frames/);
+    expect(() => decoder.decodeLatents(latents.subarray(0, 2 * 2 * d), poseTok, 3)).toThrow(/decodeLatents: latents holds 128 floats, fewer than 3 frames of 64/);
+    expect(() => decoder.decodeLatents(latents, poseTok.subarray(0, d), 2)).toThrow(/poseToken holds 32 floats/);
+    expect(() => decoder.decodeLatents(latents, poseTok, 1.5)).toThrow(/frames must be a whole number/);
+    expect(() => new ReferenceDecoder(weights, template.adjacency, m).decode(tokens, poseTok, frames + 1)).toThrow(/ReferenceDecoder.decode: tokens/);
+    expect(Array.from(decoder.decodeLatents(latents, poseTok, 2).pose).every(Number.isFinite)).toBe(true);
+  });
+
   it('the engine\'s default CPU decoder here is the SIMD one', async () => {
     const m = manifest.model.config;
     const template = await loadTemplateFile(manifest);

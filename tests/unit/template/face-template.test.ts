@@ -110,6 +110,20 @@ describe('template decoding rejects broken files with a clear error', () => {
     await expect(decodeTemplate({ hello: 1 }, asArrayBuffer(binaryBytes))).rejects.toThrow(/not a face template/);
   });
 
+  it('1-rings the attention cannot read: decreasing offsets, a vertex in its own ring, out of order, one-sided', async () => {
+    const broken = async (edit: (offsets: Uint32Array, indices: Uint32Array) => void) => {
+      const adjacency = { offsets: t.adjacency.offsets.slice(), indices: t.adjacency.indices.slice() };
+      edit(adjacency.offsets, adjacency.indices);
+      const { header, binary } = await encodeTemplate({ ...t, adjacency }, 'template.bin');
+      return decodeTemplate(JSON.parse(JSON.stringify(header)), binary.buffer as ArrayBuffer);
+    };
+    const o = t.adjacency.offsets, n = t.vertexCount;
+    await expect(broken((off) => { off[2] = off[1] - 1; })).rejects.toThrow(/adjacencyOffsets decrease at vertex 1/);
+    await expect(broken((_, idx) => { idx[o[0]] = 0; })).rejects.toThrow(/1-ring of vertex 0 lists itself/);
+    await expect(broken((_, idx) => { [idx[o[0]], idx[o[0] + 1]] = [idx[o[0] + 1], idx[o[0]]]; })).rejects.toThrow(/vertex 0 is not in ascending order/);
+    await expect(broken((_, idx) => { idx[o[1] - 1] = n - 1; })).rejects.toThrow(new RegExp(`vertex 0 lists ${n - 1}, whose ring lacks 0`));
+  });
+
   it('round-trips through encode/decode', async () => {
     const { header, binary } = await encodeTemplate(t, 'template.bin');
     const again = await decodeTemplate(JSON.parse(JSON.stringify(header)), binary.buffer as ArrayBuffer);

@@ -169,10 +169,25 @@ def _read_native(path: Path) -> Template:
     )
     if t.vertices.shape != (n, 3) or t.adj_offsets.shape != (n + 1,):
         raise TemplateFormatError(f"template {t.id}: buffer sizes do not match vertexCount {n}")
+    check_adjacency(t)
     missing = [r for r in REQUIRED_REGIONS if t.regions.get(r, np.empty(0)).size == 0]
     if missing:
         raise TemplateFormatError(f"template {t.id} lacks the regions {', '.join(missing)} (docs/templates.md)")
     return t
+
+
+def check_adjacency(t: Template) -> None:
+    """The 1-rings in CSR form as the attention reads them (as the browser checks them: src/template/face-template.ts):
+    offsets from 0 to the index count, never decreasing; each ring ascending, without its vertex; symmetric."""
+    off, idx, n = t.adj_offsets, t.adj_indices, t.num_vertices
+    if off[0] != 0 or off[-1] != len(idx) or (np.diff(off) < 0).any() or ((idx < 0) | (idx >= n)).any():
+        raise TemplateFormatError(f"template {t.id}: adjacencyOffsets must rise from 0 to the index count, indices in range")
+    row = np.repeat(np.arange(n), np.diff(off))
+    same = row[1:] == row[:-1]
+    why = ("a vertex lists itself" if (idx == row).any() else "a ring is not in ascending order" if (idx[1:][same] <= idx[:-1][same]).any()
+           else "a ring lists a vertex whose ring lacks it" if not np.isin(idx * n + row, row * n + idx).all() else "")
+    if why:
+        raise TemplateFormatError(f"template {t.id}: {why} (adjacencyIndices: symmetric, no self loops, ascending)")
 
 
 def subdivide(t: Template, new_id: str | None = None) -> Template:
