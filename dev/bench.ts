@@ -51,9 +51,13 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   result.ort_build = fetched.some((r) => r.name.includes('.jsep.')) ? 'jsep' : 'wasm';
   const rate = engine.manifest.audio.sample_rate;
   const wav = await decodeAudio(wavBytes, rate);
-  // The head on screen (dev/render-bench.ts): 3 s of speech drawn frame by frame.
-  result.render = await renderBench(engine, speechOf(3, wav.samples, rate));
-  if (renderOnly) return result;
+  // The head on screen (dev/render-bench.ts): 3 s of speech drawn frame by frame. After the timed rows, so that the
+  // first of them (the "cold" one) is the first clip animated after loading, as its name says.
+  const render = async () => (result.render = await renderBench(engine, speechOf(3, wav.samples, rate)));
+  if (renderOnly) {
+    await render();
+    return result;
+  }
   result.cpu_decoder_threads = engine.cpuThreads;
   result.cpu_decoder_kernel = engine.cpuKernel;
   result.cpu_decoder_fma = fmaModule() !== null; // its matrix products and GELU fused (relaxed SIMD)
@@ -90,6 +94,8 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
     }
   }
   result.runs = stages;
+  await engine.setBackend('cpu'); // the engine as loaded
+  await render();
 
   // Decode time per frame against the vertex count (decoder weights do not depend on N).
   const m = engine.manifest.model.config;
@@ -153,7 +159,8 @@ async function run(wavBytes: ArrayBuffer, backends: Backend[], clipSeconds: numb
   result.stream_piece_ms = (piece / rate) * 1000;
   result.stream_latency_ms = lat.p50Ms;
   result.stream_latency_p95_ms = lat.p95Ms;
-  result.stream_processing_p50_ms = lat.p50Ms - stream.lookAheadMs;
+  // Past the look-ahead: the frame's sample waiting for the rest of its piece (up to one piece), and processing.
+  result.stream_beyond_look_ahead_p50_ms = lat.p50Ms - stream.lookAheadMs;
   return result;
 }
 

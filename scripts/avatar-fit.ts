@@ -13,7 +13,6 @@
  * the solve alone) and in the page (the whole avatar stage: solve, visemes, head angles).
  */
 import { chromium } from '@playwright/test';
-import { spawn } from 'node:child_process';
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
@@ -23,13 +22,22 @@ import { arkitBasis } from '../src/avatar/basis';
 import { faceFields } from '../src/avatar/fields';
 import { BlendshapeSolver } from '../src/avatar/solver';
 import { ARKIT_INDEX, ARKIT_NAMES, VISEME_NAMES } from '../src/avatar/names';
+import { portFree, readOptions, startServer, usageError, within } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
-const args = process.argv.slice(2);
-const opt = (name: string, fallback: string) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
-const CORPUS = resolve(ROOT, opt('--corpus', 'data/corpus'));
-const MAX_CLIPS = Number(opt('--max-clips', '80'));
-const PORT = Number(opt('--port', '4195'));
+const USAGE = `usage: npm run avatar-fit [-- --corpus data/corpus --max-clips 80 --port 4195]
+       npm run avatar-fit -- --from-json      (rewrite docs/results/avatar.md from its .json, nothing run)`;
+const opts = readOptions('avatar-fit', USAGE, {
+  corpus: { type: 'string', default: 'data/corpus' }, 'max-clips': { type: 'string', default: '80' },
+  port: { type: 'string', default: '4195' }, 'from-json': { type: 'boolean' },
+});
+const whole = (name: string, low: number): number => {
+  const v = Number(opts[name]);
+  return Number.isInteger(v) && v >= low ? v : usageError('avatar-fit', USAGE, `--${name} ${String(opts[name])}: a whole number from ${low}`);
+};
+const CORPUS = resolve(ROOT, String(opts.corpus));
+const MAX_CLIPS = whole('max-clips', 1);
+const PORT = whole('port', 1);
 const OPEN_VOWELS = new Set(['AA', 'AE', 'AH', 'AO', 'AW', 'AY']); // talkingface.phones.OPEN_VOWELS
 const BILABIALS = new Set(['P', 'B', 'M']);
 
@@ -98,23 +106,22 @@ async function main(): Promise<void> {
   const solves: number[] = [];
   let pageStageMs = 0, pageFrames = 0, unposedChange = 0, streamChange = 0;
 
-  const server = spawn('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], { cwd: ROOT, stdio: 'ignore', detached: true });
+  if (!clips.length) throw new Error(`no clips to measure in ${source}`);
+  if (!(await portFree(PORT))) throw new Error(`port ${PORT} is in use (another server would answer): free it, or give --port`);
+  // (script-cli stops it on Ctrl-C and on any exit, the finally below or not)
+  const server = startServer('npx', ['vite', '--host', '127.0.0.1', '--port', String(PORT), '--strictPort'], ROOT);
+  await server.ready(`http://127.0.0.1:${PORT}/dev/avatar-fit.html`, 120);
   const browser = await chromium.launch({ executablePath: process.env.CHROMIUM_PATH ?? '/usr/bin/chromium', args: CHROMIUM_ARGS });
   let info: Record<string, unknown> = {};
   try {
     const page = await browser.newPage();
-    for (let tries = 0; ; tries++) {
-      try { await page.goto(`http://127.0.0.1:${PORT}/dev/avatar-fit.html`); break; } catch (e) {
-        if (tries > 60) throw e;
-        await new Promise((r) => setTimeout(r, 1000));
-      }
-    }
+    await page.goto(`http://127.0.0.1:${PORT}/dev/avatar-fit.html`);
     await page.waitForFunction(() => document.getElementById('status')?.textContent === 'Ready.', undefined, { timeout: 120_000 });
     info = await page.evaluate(() => (globalThis as unknown as { avatarFit: { info(): Record<string, unknown> } }).avatarFit.info());
     for (const [c, clip] of clips.entries()) {
-      const r = await page.evaluate(async (s) => (globalThis as unknown as { avatarFit: { clip(s: number[]): Promise<{
+      const r = await within(page.evaluate(async (s) => (globalThis as unknown as { avatarFit: { clip(s: number[]): Promise<{
         frames: number; unposed: string; arkit: string; visemes: string; stageMs: { blendshapes: number }; unposedChange: number; streamChange: number }> } })
-        .avatarFit.clip(s), Array.from(clip.samples));
+        .avatarFit.clip(s), Array.from(clip.samples)), 300, `clip ${clip.key} in the page`);
       const F = r.frames, unposed = f32(r.unposed), arkit = f32(r.arkit), visemes = f32(r.visemes);
       pageStageMs += r.stageMs.blendshapes;
       pageFrames += F;
@@ -166,7 +173,7 @@ async function main(): Promise<void> {
     }
   } finally {
     await browser.close();
-    try { process.kill(-server.pid!); } catch { /* deliberate: the server may have exited already */ }
+    server.stop();
   }
   process.stdout.write('\n');
 
@@ -246,6 +253,6 @@ difference: ${r.streamedAgainstOffline}).
 `;
 }
 
-if (args.includes('--from-json')) {
+if (opts['from-json']) {
   writeFileSync(resolve(ROOT, 'docs/results/avatar.md'), report(JSON.parse(readFileSync(resolve(ROOT, 'docs/results/avatar.json'), 'utf8'))));
 } else await main();

@@ -21,7 +21,7 @@ import { StreamResampler } from '../src/audio/resample';
 import { SPEECH, readWav16 } from '../tests/e2e/helpers/audio';
 import { measureFirstLoad, measureOnnxAlone, printFirstLoad, type FirstLoad } from './first-load';
 import { measureLiveDisplay, printLiveDisplay, type LiveDisplay } from './live-display';
-import { envPort, portFree, positiveNumbers, readOptions, startServer, usageError } from './script-cli';
+import { envPort, portFree, positiveNumbers, readOptions, startServer, usageError, within } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const USAGE = `npm run bench [-- OPTIONS]   the engine's speed and memory in headless Chromium -> docs/results/bench.json
@@ -147,10 +147,10 @@ async function main(): Promise<void> {
     await page.waitForFunction(() => document.body.dataset.ready === 'true');
     const wav = readFileSync(resolve(ROOT, 'tests/fixtures/speech-kal.wav')).toString('base64');
     const t0 = Date.now();
-    const result = (await page.evaluate(
+    const result = (await within(page.evaluate(
       ([w, b, s, r]) => (globalThis as unknown as { runBench: (w: string, b: string[], s: number[], r: boolean) => Promise<Record<string, unknown>> }).runBench(w, b, s, r),
       [wav, backends, seconds, renderOnly] as const,
-    )) as Record<string, unknown>;
+    ), 1800, 'the benchmark page')) as Record<string, unknown>;
     await browser.close();
     if (result.error) throw new Error(`benchmark failed in the page: ${result.error}`);
     if (renderOnly) {

@@ -23,7 +23,7 @@ import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, resolve } from 'node:path';
 import { CHROMIUM_ARGS } from '../playwright.config';
 import { readWav16 } from '../tests/e2e/helpers/audio';
-import { envPort, portFree, readOptions, startServer, usageError } from './script-cli';
+import { envPort, portFree, readOptions, startServer, usageError, within } from './script-cli';
 
 const ROOT = resolve(import.meta.dirname, '..');
 const args = process.argv.slice(2);
@@ -164,10 +164,10 @@ async function main() {
     const groups = { all: group(), human: group() };
     const cost = { ours: 0, ha: 0, wl: 0, seconds: 0 };
     for (const [i, clip] of clips.entries()) {
-      const r = await page.evaluate(async (s) => (globalThis as unknown as { compare: { compareClip(s: number[]): Promise<{
+      const r = await within(page.evaluate(async (s) => (globalThis as unknown as { compare: { compareClip(s: number[]): Promise<{
         ours: { gapMm: number[]; ms: number }; headaudio: { events: { viseme: number; t: number }[]; ms: number };
         wlipsync?: { names: string[]; volume: number[]; ms: number } }> } }).compare.compareClip(s),
-        Array.from(clip.samples));
+        Array.from(clip.samples)), 300, `clip ${clip.key ?? i} in the page`);
       const seconds = clip.samples.length / 16000;
       cost.ours += r.ours.ms; cost.ha += r.headaudio.ms; cost.wl += r.wlipsync?.ms ?? 0; cost.seconds += seconds;
       const gap = r.ours.gapMm;

@@ -53,6 +53,7 @@ async function oneLoad(browser: Browser, url: string): Promise<{ files: FetchedF
   const seen = new Map<string, FetchedFile>();
   const pending: Promise<void>[] = [];
   const record = (req: Request) => pending.push((async () => {
+    // (a request the context's close cut short rejects: counted as not fetched, not an unhandled rejection)
     const res = await req.response();
     const sizes = await req.sizes();
     // A worker's script reports no body size to Playwright: its Content-Length (set by the preview server) stands in.
@@ -66,14 +67,20 @@ async function oneLoad(browser: Browser, url: string): Promise<{ files: FetchedF
     }
     f.encoding = (await res?.headerValue('content-encoding')) ?? 'identity';
     seen.set(path, f);
-  })());
+  })().catch(() => undefined)); // see above
   page.on('requestfinished', record);
   await page.goto(url);
   await page.waitForSelector('body[data-engine]', { timeout: 60_000 });
   const state = await page.evaluate(() => document.body.dataset.engine);
   if (state !== 'ready') throw new Error(`${url} did not get ready (data-engine=${state}${await page.evaluate(() => document.body.dataset.error ? `: ${document.body.dataset.error}` : '')})`);
   await page.waitForTimeout(500); // let late requests (the rest face's work, sample index) finish
-  await Promise.all(pending);
+  // Every request seen, those that finish while the first are awaited too; then no more are taken.
+  for (let counted = 0; counted < pending.length; ) {
+    const now = pending.length;
+    await Promise.all(pending.slice(counted, now));
+    counted = now;
+  }
+  page.off('requestfinished', record);
   const marks = await page.evaluate(() => (globalThis as unknown as { readyMarks: { face?: number; engine: number } }).readyMarks);
   await context.close();
   return { files: [...seen.values()].filter((f) => f.fetches > 0).sort((a, b) => b.bytes - a.bytes), face: marks.face, engine: marks.engine };

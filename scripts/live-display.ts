@@ -13,8 +13,10 @@ export interface LiveDisplay {
   /** The face's renders per second while recording, and at rest (idle life: breathing, blinks). */
   renders_per_second: number;
   idle_renders_per_second: number;
-  /** Live frames the model made in the take, and how many the face showed (the rest passed unseen). */
+  /** Live frames the model made in the whole take; the frames the speech of the counted seconds has (fps x seconds),
+   * and how many of those the face showed (the rest passed unseen). */
   frames_made: number;
+  frames_in_window: number;
   frames_shown: number;
   /** Median time between two live frames shown (ms). */
   shown_gap_p50_ms: number;
@@ -44,9 +46,9 @@ export async function measureLiveDisplay(url: string, wav: string, scale: number
     await page.evaluate(COUNT);
     await page.waitForTimeout(3000);
     const idle = await page.evaluate('globalThis.counts.renders') as number;
-    await page.evaluate(COUNT);
     await page.click('#record-button');
     await page.waitForSelector('body[data-recording=true]', { timeout: 20_000 });
+    await page.evaluate(COUNT); // counted from here: the renders while the recording starts up are no live frames
     const t0 = Date.now();
     await page.waitForTimeout(seconds * 1000);
     const during = await page.evaluate(`({ renders: globalThis.counts.renders, shown: globalThis.counts.shown.slice() })`) as { renders: number; shown: number[] };
@@ -54,13 +56,14 @@ export async function measureLiveDisplay(url: string, wav: string, scale: number
     await page.click('#record-button');
     await page.waitForSelector('body[data-take=ready]', { timeout: 60_000 });
     const made = await page.evaluate('globalThis.talkingFace.take.animation.frames') as number;
+    const fps = await page.evaluate('globalThis.talkingFace.take.animation.fps') as number;
     const gaps = during.shown.slice(1).map((t, i) => t - during.shown[i]).sort((a, b) => a - b);
     const t1 = Date.now();
     await page.locator('#sample-select').selectOption({ index: 1 });
     await page.waitForFunction(() => document.body.dataset.take === 'ready' && (globalThis as unknown as { talkingFace: { take: { name: string } } }).talkingFace.take.name !== 'Recording', null, { timeout: 60_000 });
     return {
       device_scale_factor: scale, renders_per_second: during.renders / elapsed, idle_renders_per_second: idle / 3,
-      frames_made: made, frames_shown: during.shown.length, shown_gap_p50_ms: gaps[gaps.length >> 1] ?? NaN, sample_ms: Date.now() - t1,
+      frames_made: made, frames_in_window: Math.round(fps * elapsed), frames_shown: during.shown.length, shown_gap_p50_ms: gaps[gaps.length >> 1] ?? NaN, sample_ms: Date.now() - t1,
     };
   } finally {
     await browser.close();
@@ -70,7 +73,7 @@ export async function measureLiveDisplay(url: string, wav: string, scale: number
 export function printLiveDisplay(runs: LiveDisplay[]): void {
   for (const r of runs) {
     console.log(`live in the demo (${r.device_scale_factor}x screen): face drawn ${r.renders_per_second.toFixed(1)} times a second ` +
-      `(${r.idle_renders_per_second.toFixed(1)} at rest), ${r.frames_shown} of ${r.frames_made} live frames shown ` +
+      `(${r.idle_renders_per_second.toFixed(1)} at rest), ${r.frames_shown} of the ${r.frames_in_window} live frames of those seconds shown ` +
       `(one every ${r.shown_gap_p50_ms.toFixed(0)} ms, median); a sample clip animated in ${(r.sample_ms / 1000).toFixed(1)} s`);
   }
 }

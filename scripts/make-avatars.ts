@@ -7,7 +7,7 @@
  * (VRoid's morph-target names on the full-body rig, driven only through the file's VRM 1.0 or 0.x extension;
  * src/avatar/vrm-test-avatar.ts). A unit test checks that the committed files are exactly what this writes.
  */
-import { readFileSync, writeFileSync } from 'node:fs';
+import { readFileSync, realpathSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { decodeTemplate } from '../src/template/face-template';
 import { buildAvatarGlb } from '../src/avatar/avatar-mesh';
@@ -34,7 +34,7 @@ export async function makeAvatars(): Promise<Record<string, Uint8Array>> {
   return out;
 }
 
-if (process.argv[1] === import.meta.filename) {
+if (process.argv[1] && realpathSync(process.argv[1]) === import.meta.filename) { // (run through a link too)
   for (const [file, bytes] of Object.entries(await makeAvatars())) {
     writeFileSync(resolve(ROOT, 'examples/avatars', file), bytes);
     console.log(`examples/avatars/${file}: ${(bytes.byteLength / 1024).toFixed(0)} kB`);

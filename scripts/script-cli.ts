@@ -31,6 +31,20 @@ export function usageError(script: string, usage: string, message: string): neve
   process.exit(2);
 }
 
+/** `work`, or an Error saying `what` did not finish within `seconds` (a page whose promise never settles would hold
+ * the script, and its server, for ever). */
+export async function within<T>(work: Promise<T>, seconds: number, what: string): Promise<T> {
+  let timer: ReturnType<typeof setTimeout> | undefined;
+  const late = new Promise<never>((_, reject) => {
+    timer = setTimeout(() => reject(new Error(`${what} did not finish within ${seconds} s`)), seconds * 1000);
+  });
+  try {
+    return await Promise.race([work, late]);
+  } finally {
+    clearTimeout(timer);
+  }
+}
+
 /** A comma-separated list of numbers above zero ("10,60"), or null saying nothing valid was given. */
 export function positiveNumbers(text: string): number[] | null {
   const xs = text.split(',').map((s) => Number(s.trim()));
@@ -65,10 +79,14 @@ const running = new Set<() => void>();
 let signalsHeld = false;
 
 /** Ctrl-C (or a SIGTERM) stops every server still running, then the script: its `finally` would not run, and a server
- * left behind would hold its port for the next run. */
+ * left behind would hold its port for the next run. So does the script's exit on any other path (an error thrown
+ * before its `try`, a browser that would not start). */
 function stopOnSignals(): void {
   if (signalsHeld) return;
   signalsHeld = true;
+  process.once('exit', () => {
+    for (const stop of [...running]) stop();
+  });
   for (const signal of ['SIGINT', 'SIGTERM'] as const) {
     process.once(signal, () => {
       for (const stop of [...running]) stop();

@@ -74,11 +74,18 @@ ensure_uv() {
   if [ -x "$UV" ] && [ "$("$UV" --version | cut -d' ' -f2)" = "$UV_VERSION" ]; then return 0; fi
   local py="${PYTHON:-python3}"
   ensure_python || return 1
+  # A venv needs ensurepip, which Debian and Ubuntu ship apart (python3.X-venv).
+  if ! "$py" -c 'import ensurepip' 2>/dev/null; then
+    local venv_pkg
+    venv_pkg="python$("$py" -c 'import sys; print("%d.%d" % sys.version_info[:2])')-venv"
+    if command -v dpkg >/dev/null; then ensure_apt "$venv_pkg" || return 1
+    else say "$py cannot make a virtual environment (no ensurepip): install its venv module ($venv_pkg on Debian)"; return 1; fi
+  fi
   say "installing uv $UV_VERSION into $UV_HOME (hash-checked)"
   rm -rf "$UV_HOME"
-  "$py" -m venv "$UV_HOME"
+  "$py" -m venv "$UV_HOME" || { say "could not make a virtual environment for uv at $UV_HOME"; return 1; }
   "$UV_HOME/bin/python" -m pip install --disable-pip-version-check -q --require-hashes \
-    -r "$REPO_ROOT/scripts/uv-requirements.txt"
+    -r "$REPO_ROOT/scripts/uv-requirements.txt" || { say "could not install uv $UV_VERSION with pip"; return 1; }
 }
 
 ensure_venv() {

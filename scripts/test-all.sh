@@ -15,7 +15,7 @@ step() {
   local t0=$SECONDS
   if "$@"; then say "$name: ok ($((SECONDS - t0)) s)"; passed=$((passed + 1)); else say "$name: FAILED ($((SECONDS - t0)) s)"; failed+=("$name"); fi
 }
-step "pytest (training/)" bash -c "cd training && PYTHONPATH='$REPO_ROOT/training/src' '$TALKING_FACE_VENV/bin/python' -m pytest -q"
+step "pytest (training/)" bash -c 'cd training && PYTHONPATH="$1/training/src" "$2/bin/python" -m pytest -q' _ "$REPO_ROOT" "$TALKING_FACE_VENV"
 step "typecheck (tsc)" npx tsc -p .
 step "vitest" npx vitest run
 step "playwright (headless chromium)" npx playwright test

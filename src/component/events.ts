@@ -33,8 +33,9 @@ export interface FrameDetail extends Partial<FrameWeights> {
   /** 'stream': speech written to speakStream(), one event per frame shown. */
   mode: 'playback' | 'live' | 'stream';
   backend: Backend;
-  /** Offline: compute time per frame of the animation (ms). Live: measured sample-in -> frame-out latency (ms). */
+  /** Playback: compute time per frame of the animation (ms); not set live or for a stream. */
   inferenceMs?: number;
+  /** Live and stream: the measured latency from a sample in to its frame out (ms). */
   latencyMs?: number;
   /**
    * Live: frames skipped so far to stay live (0 while the device keeps up). Above 0 the device is slower than real
@@ -52,7 +53,7 @@ export interface FrameDetail extends Partial<FrameWeights> {
 
 export interface TalkingFaceErrorDetail {
   message: string;
-  /** What failed: loading the model, decoding audio, the microphone, inference, or the avatar. */
+  /** What failed: loading the model, decoding audio, the microphone, inference, the avatar, or drawing the face. */
   stage: 'model' | 'audio' | 'microphone' | 'inference' | 'avatar' | 'render';
 }
 

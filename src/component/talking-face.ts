@@ -1,7 +1,7 @@
 /**
- * <talking-face>: the whole thing as one custom element (shadow DOM); docs/embedding.md. Instances with the same model
- * and backend share one engine. Attributes: model, template, src, backend, autoplay, live, avatar (a glTF avatar driven
- * instead of the face), avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3, default 1), muted. Methods:
+ * <talking-face>: the whole thing as one custom element (shadow DOM); docs/embedding.md. Instances with the same model,
+ * template and backend share one engine. Attributes: model, template, src, backend, autoplay, live, avatar (a glTF
+ * avatar instead of the face), avatar-head-bone, avatar-facing, blendshapes, head-motion (0-3), muted, hide-status. Methods:
  * speak(audio), speakStream(options), startMicrophone(), stop(), recordVideo(). Events: ready, frame, ended, error.
  */
 import { AvatarView } from '../avatar/avatar-view';
@@ -123,7 +123,7 @@ export class TalkingFaceElement extends ElementBase {
   }
 
   /**
-   * Animate and play `audio` (a Blob or File, an AudioBuffer, or a URL on this page's origin). Resolves
+   * Animate and play `audio` (a Blob or File, an AudioBuffer, or a URL: same origin, or CORS-enabled). Resolves
    * when playback ends (or stop() is called); rejects with a readable Error, also sent as an error event.
    */
   async speak(audio: Blob | AudioBuffer | URL | string): Promise<void> {

@@ -4,9 +4,11 @@
  */
 import { describe, expect, it } from 'vitest';
 import { spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:net';
-import { resolve } from 'node:path';
-import { positiveNumbers, portFree, startServer } from '../../../scripts/script-cli';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { positiveNumbers, portFree, startServer, within } from '../../../scripts/script-cli';
 
 const ROOT = resolve(import.meta.dirname, '../../..');
 const run = (script: string, ...args: string[]) =>
@@ -17,6 +19,12 @@ describe('script-cli', () => {
     expect(positiveNumbers('10,60')).toEqual([10, 60]);
     expect(positiveNumbers('2.5')).toEqual([2.5]);
     for (const bad of ['abc', '10,', '0', '-1', '10,x', '']) expect(positiveNumbers(bad), bad).toBeNull();
+  });
+
+  it('gives up on work that never finishes, saying what; passes on what does', async () => {
+    await expect(within(new Promise(() => undefined), 0.05, 'the benchmark page')).rejects.toThrow('the benchmark page did not finish within 0.05 s');
+    await expect(within(Promise.resolve(7), 0.05, 'x')).resolves.toBe(7);
+    await expect(within(Promise.reject(new Error('its own')), 5, 'x')).rejects.toThrow('its own');
   });
 
   it('sees a port in use', async () => {
@@ -34,8 +42,37 @@ describe('script-cli', () => {
     await expect(server.ready('http://127.0.0.1:9/', 20)).rejects.toThrow(/exited \(1\)[\s\S]*already in use/);
   });
 
-  it('bench and compare: --help prints the usage; a wrong option, value or number stops them with exit 2', () => {
-    for (const script of ['bench', 'compare']) {
+  it('a script that fails outside its try (a browser that would not start) leaves no server behind', async () => {
+    const dir = mkdtempSync(join(tmpdir(), 'script-cli-'));
+    try {
+      const pidFile = join(dir, 'server.pid');
+      const server = `require("fs").writeFileSync(${JSON.stringify(pidFile)}, String(process.pid)); setInterval(() => {}, 1000)`;
+      const script = `import { startServer } from ${JSON.stringify(resolve(ROOT, 'scripts/script-cli.ts'))};
+        startServer('node', ['-e', ${JSON.stringify(server)}], '.');
+        setTimeout(() => { throw new Error('chromium would not start'); }, 1500);`;
+      writeFileSync(join(dir, 'fails.ts'), script);
+      const r = spawnSync('npx', ['tsx', join(dir, 'fails.ts')], { cwd: ROOT, encoding: 'utf8', timeout: 60_000 });
+      expect(r.status).not.toBe(0);
+      const pid = Number(readFileSync(pidFile, 'utf8'));
+      // Running: it answers signal 0 and is no zombie (killed, it waits a moment for its new parent to reap it).
+      const running = () => {
+        try {
+          process.kill(pid, 0);
+        } catch {
+          return false;
+        }
+        return !/^\d+ \(.*\) Z/.test(readFileSync(`/proc/${pid}/stat`, 'utf8'));
+      };
+      const alive = running();
+      if (alive) process.kill(pid); // (not left running after a failure of this test)
+      expect(alive, `server ${pid} still running`).toBe(false);
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  });
+
+  it('bench, compare and avatar-fit: --help prints the usage; a wrong option, value or number stops them with exit 2', () => {
+    for (const script of ['bench', 'compare', 'avatar-fit']) {
       const help = run(script, '--help');
       expect(help.status, `${script} --help`).toBe(0);
       expect(help.stdout).toContain(`npm run ${script}`);
@@ -49,6 +86,8 @@ describe('script-cli', () => {
       ['compare', ['--max-clip', '3'], /Unknown option '--max-clip'/],
       ['compare', ['--corpus', '/nonexistent'], /no corpus there/],
       ['compare', ['--samples', 'models/samples'], /--samples needs --out/],
+      ['avatar-fit', ['--max-clips', 'x'], /--max-clips x: a whole number from 1/],
+      ['avatar-fit', ['--max-clip', '3'], /Unknown option '--max-clip'/],
     ] as const) {
       const r = run(script, ...args);
       expect(r.status, `${script} ${args.join(' ')}`).toBe(2);
