@@ -83,7 +83,9 @@ export class GpuDecoder {
     framesWanted: number,
   ) {
     const d = m.d_model;
-    if ((d & (d - 1)) !== 0 || d > 256) throw new Error(`GpuDecoder: d_model ${d} must be a power of two up to 256`);
+    // From 8: the heads' pass writes pose channel i from thread i (six of them); the heads split d evenly.
+    if ((d & (d - 1)) !== 0 || d < 8 || d > 256) throw new Error(`GpuDecoder: d_model ${d} must be a power of two from 8 to 256`);
+    if (d % m.heads !== 0) throw new Error(`GpuDecoder: ${m.heads} heads do not divide d_model ${d}`);
     if (m.ffn > 512) throw new Error(`GpuDecoder: ffn ${m.ffn} exceeds the shader's 512`);
     this.n = adjacency.offsets.length - 1;
     this.t = this.n + 1;

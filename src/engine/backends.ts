@@ -47,6 +47,7 @@ export class DecoderBackends {
     options: BackendOptions = {}): Promise<DecoderBackends> {
     const mismatch = vertexEmbeddingMismatch(weights, adjacency.offsets.length - 1, m.d_model);
     if (mismatch) throw new ModelLoadError(mismatch);
+    const cpu = new FastDecoder(weights, adjacency, m); // first: a throw here leaves no WebGPU buffers behind
     const hardwareGpu = isHardwareAdapter(support);
     let gpu: GpuDecoder | null = null;
     let reason = 'CPU decoder chosen';
@@ -67,7 +68,7 @@ export class DecoderBackends {
       }
       if (options.backend === 'webgpu' && !gpu) throw new ModelLoadError(`WebGPU was requested but is not available: ${reason}`);
     }
-    const backends = new DecoderBackends(new FastDecoder(weights, adjacency, m), gpu, reason, adjacency, m, gpuFrames);
+    const backends = new DecoderBackends(cpu, gpu, reason, adjacency, m, gpuFrames);
     const cores = globalThis.navigator?.hardwareConcurrency ?? 1;
     backends.pool = await DecoderPool.create(options.cpuWorkers ?? Math.min(4, cores), weights, adjacency, m);
     if (!backends.pool && cores > 1 && options.cpuWorkers === undefined) backends.reason += `; CPU decoder in the page's thread (${DecoderPool.lastFailure})`;

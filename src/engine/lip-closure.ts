@@ -10,7 +10,7 @@
  *
  * Where the face's lips already touch (g <= MIN_GAP_MM: a face modelled with its mouth shut, or beyond the corners)
  * every closing is a full one: the model's closing is taken out there and the lips stay touching (it pressed them
- * through each other by its whole closing, 7.5 mm on /p b m/); an opening is the model's.
+ * through each other by its whole closing, 6.4 mm in silence); an opening is the model's.
  *
  * Before that, the mouth's amplitude: the model's offsets on the lips' tissue and the jaw are scaled by the
  * manifest's mouth gain, fading to 1 with the rig's fields (a regression opens the mouth by about three quarters of

@@ -3,7 +3,9 @@
  * WebGPU only logs an error and the batch reads back zeros, so a decoder is sized within them or refused.
  */
 import { describe, expect, it } from 'vitest';
-import { gpuFramesWithin } from '../../../src/attention/gpu-decoder';
+import { GpuDecoder, gpuFramesWithin } from '../../../src/attention/gpu-decoder';
+import type { DecoderWeights } from '../../../src/attention/reference';
+import type { ModelConstants } from '../../../src/model/manifest';
 
 const DEFAULTS = { maxStorageBufferBindingSize: 134_217_728, maxBufferSize: 268_435_456, maxComputeWorkgroupsPerDimension: 65_535 };
 
@@ -27,5 +29,14 @@ describe('gpuFramesWithin', () => {
     expect(() => gpuFramesWithin(DEFAULTS, 70_000, 32, 200_000, 96)).toThrow(/70001 tokens exceed this device's 65535 workgroups per dispatch/);
     expect(() => gpuFramesWithin(DEFAULTS, 468, 32, 40_000_000, 96)).toThrow(/weights \(160000000 bytes\) exceed this device's 134217728-byte storage binding/);
     expect(() => gpuFramesWithin({ ...DEFAULTS, maxStorageBufferBindingSize: 1 << 20 }, 5023, 32, 1000, 96)).toThrow(/one frame of 5024 tokens of 32/);
+  });
+
+  it('refuses, before touching the device, a model the shader cannot run', () => {
+    const build = (d_model: number, heads: number) => () =>
+      new GpuDecoder({} as GPUDevice, {} as DecoderWeights, { offsets: new Uint32Array(1), indices: new Uint32Array(0) },
+        { d_model, heads, ffn: 64 } as ModelConstants, 8);
+    expect(build(4, 1)).toThrow(/d_model 4 must be a power of two from 8 to 256/); // pose channels 4 and 5 unwritten
+    expect(build(48, 4)).toThrow(/power of two/);
+    expect(build(32, 3)).toThrow(/3 heads do not divide d_model 32/);
   });
 });

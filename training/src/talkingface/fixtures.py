@@ -26,7 +26,8 @@ def write_fixtures(model: TalkingFace, template_mm: np.ndarray, audio: np.ndarra
     own motion (model/head_motion.py) when given: its residuals for seed 0, and the poses and vertices with it;
     with the lip closure (model/lip_closure.py) when given: the offsets it gives the template's face, and those
     of a face with its lips parted 1.5 mm further (the lower lip's tissue lowered), so the test sees both ways, and of
-    one with its lips meeting at rest (raised by the face's gap)."""
+    one with its lips shut at rest (the lower lip's tissue raised by the face's gap: they meet in the middle and
+    cross towards the corners, where the face's own gap is smaller)."""
     a = model.audio
     mel = log_mel(audio, a)                                                    # (K, n_mels)
     n_frames = int(round(len(audio) / a.sample_rate * a.fps))

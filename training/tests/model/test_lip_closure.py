@@ -97,8 +97,16 @@ def test_a_face_with_its_lips_shut_keeps_them_touching_and_opens_as_the_model_op
     assert len(lc.active) == 0 and len(lc.touching) > len(template.regions["lips_inner_upper"])
     raw = lip_gap(shut_face[None] + closing, template)[0]
     assert raw < -0.8 * ref_gap                      # as the model closes: pressed through by its whole closure
-    for scale in (1.0, 0.5, 1.4):                    # any closing, full, half or beyond, leaves them touching
-        assert abs(lip_gap(shut_face[None] + lc.apply(scale * closing), template)[0]) < 0.05
+    r = template.regions
+    inner, lower = np.setdiff1d(r["lips_inner_upper"], r["lips_inner_lower"]), np.asarray(r["lips_inner_lower"])
+
+    def across(v):  # the gap at each x across the mouth (the upper lip's vertices but the corners)
+        lo = lower[np.argsort(v[lower, 0])]
+        return v[inner, 1] - np.interp(v[inner, 0], v[lo, 0], v[lo, 1])
+    rest = across(shut_face)
+    assert rest.max() < 0.05 and rest.min() < -1.0   # shut: they meet in the middle, cross towards the corners
+    for scale in (1.0, 0.5, 1.4):                    # any closing, full, half or beyond: at each x as at rest
+        assert np.abs(across(shut_face + lc.apply(scale * closing)[0]) - rest).max() < 0.05
     assert np.allclose(lc.apply(opening), opening)   # an opening is the model's
     o = np.concatenate([closing, opening, 0.5 * closing]).astype(np.float32)
     assert np.abs(LipClosureTorch(lc).apply(torch.from_numpy(o)).numpy() - lc.apply(o)).max() < 1e-4

@@ -96,3 +96,11 @@ def test_a_front_end_calling_p_everywhere_hears_every_bilabial_and_every_other_s
     tally.add(everywhere, labels)
     s = tally.summary()
     assert s["bilabial_segments_heard"] == 1.0 and s["bilabial_false_calls"] == 1.0 and s["other_segments"] == 3
+
+
+def test_the_chance_level_never_counts_the_true_alignment():
+    # two frames: the 0.5 shift moves by one, the 0.25 and 0.75 shifts would land on 0 or 2 = the alignment itself
+    phones = [("M", 0.0, 1 / FPS), ("AA", 1 / FPS, 2 / FPS)]
+    c = art.chance_counts(np.array([0.0, 8.0]), phones, FPS)
+    assert c == {"bilabial_closed": 0, "bilabial": 1}   # only the 0.5 shift: the closure moved off the M
+    assert art.chance_counts(np.array([0.0]), [("M", 0.0, 1 / FPS)], FPS) == {"bilabial_closed": 0, "bilabial": 0}

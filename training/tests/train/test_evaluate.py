@@ -100,6 +100,10 @@ def test_the_issue_targets_read_the_evaluation(corpus, trained_run, tmp_path):
     rows = {r["measure"]: r for r in targets.check({**fake, "articulation": {"all": flapping}, "content_encoder": {"all": everywhere}})["all"]}
     for name in ("/p b m/ closed", "open vowels opened", "/p b m/ segments heard as bilabial"):
         assert rows[name]["value"] == 1.0 and rows[name]["met"] is False, name
+    # false alarms exactly at the bound meet it (0.0 + (1 - 0.9) is 0.0999... in floating point)
+    at_bound = {**everywhere, "bilabial_false_calls": 0.1}
+    rows = {r["measure"]: r for r in targets.check({**fake, "content_encoder": {"all": at_bound}})["all"]}
+    assert rows["/p b m/ segments heard as bilabial"]["met"] is True
     # another split than the issues' shows none
     val = tmp_path / "val.json"
     assert evaluate.main(["--corpus", str(corpus.root), "--checkpoint", str(trained_run / "final.pt"), "--split", "val", "--out", str(val)]) == 0

@@ -14,6 +14,8 @@ def test_members_of_each_part():
     tts, heard, unheard = ({"source": "tts"}, {"source": "human", "sentence_heard": True},
                            {"source": "human", "sentence_heard": False})
     assert [subsets.member(r, "human_unheard") for r in (tts, heard, unheard)] == [False, False, True]
+    unknown = {"source": "human", "sentence_heard": None}   # no text in its alignment: not said to be unheard
+    assert subsets.member(unknown, "human") and not subsets.member(unknown, "human_unheard")
     assert [subsets.member(r, "human") for r in (tts, heard, unheard)] == [False, True, True]
     assert [subsets.member(r, "synthetic") for r in (tts, heard, unheard)] == [True, False, False]
     assert [name for name, _ in subsets.labels("val")][-1] == "human_unheard" and subsets.labels("val")[0][1] == "all val clips"

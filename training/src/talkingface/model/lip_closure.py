@@ -17,7 +17,7 @@ it closes them fully (c = 1) they meet on any face:
 Where the face's lips already touch (g(x) <= MIN_GAP_MM: a face modelled with its mouth shut, or beyond the mouth's
 corners), g_ref is 0 and every closing motion is a full one: the model's closing there is taken out (the lips stay
 touching, gap' = g), and an opening is the model's. Without that, a closed-lip face had its lips pressed through
-each other by the whole closing motion the model learnt on parted lips (7.5 mm on /p b m/ with the shipped model).
+each other by the whole closing motion the model learnt on parted lips (6.4 mm in silence with the shipped model).
 
 du, dl: the model's vertical offsets of the upper and lower inner-lip contours interpolated at x. reference_gap is
 how far the model itself closes: calibrated on the val split (voices and faces it was not trained on) as the gap
@@ -40,7 +40,7 @@ from ..corpus.rig import Rig
 from ..geometry.contours import lip_gap
 from ..template import Template
 
-MIN_GAP_MM = 0.05  # below this the face's lips already touch: nothing to retarget at that x
+MIN_GAP_MM = 0.05  # at or below this the face's lips already touch at that x: the model's closing is taken out there
 
 
 def interpolation_matrix(x: np.ndarray, xs: np.ndarray) -> np.ndarray:

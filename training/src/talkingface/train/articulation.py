@@ -72,7 +72,10 @@ def chance_counts(gap: np.ndarray, phones, fps: float) -> dict:
     """Bilabial closures of the same gap track shifted in time (circularly), summed over CHANCE_SHIFTS."""
     c = {"bilabial_closed": 0, "bilabial": 0}
     for s in CHANCE_SHIFTS:
-        shifted = segment_counts(np.roll(gap, int(round(s * len(gap)))), phones, fps)
+        k = int(round(s * len(gap))) % max(len(gap), 1)
+        if k == 0:  # a clip of a frame or two: that shift is the true alignment, no chance level
+            continue
+        shifted = segment_counts(np.roll(gap, k), phones, fps)
         c["bilabial_closed"] += shifted["bilabial_closed"]
         c["bilabial"] += shifted["bilabial"]
     return c
@@ -166,7 +169,8 @@ def content_summary(conf: np.ndarray, heard: tuple[int, int], false_calls: tuple
     return {"frame_accuracy": float(np.trace(conf) / max(conf.sum(), 1)),
             "speech_frame_accuracy": float(np.diag(conf)[speech].sum() / max(conf[speech].sum(), 1)),
             "bilabial_segments_heard": heard[0] / max(heard[1], 1), "bilabial_segments": heard[1], **accuracy_by_kind(conf),
-            **({"bilabial_false_calls": false_calls[0] / max(false_calls[1], 1), "other_segments": false_calls[1]} if false_calls else {}),
+            **({"bilabial_false_calls": false_calls[0] / false_calls[1] if false_calls[1] else None, "other_segments": false_calls[1]}
+               if false_calls else {}),
             "recall": recall, "confusion": conf.tolist()}
 
 

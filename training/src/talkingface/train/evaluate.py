@@ -58,7 +58,7 @@ def evaluate(model, ds, split: str = "test", progress=None, head_rows: list | No
     heard_sentences, said = set(subsets.sentences(ds, "train").values()), subsets.sentences(ds, split)
     for i, key in enumerate(keys):
         c = prepare(ds, key, model.audio)
-        tags = {"source": c.source, "sentence_heard": said.get(key) in heard_sentences}
+        tags = {"source": c.source, "sentence_heard": said[key] in heard_sentences if key in said else None}
         mel = torch.from_numpy(c.mel)
         with torch.no_grad():
             heard = model.content(mel[None])[0]                               # (Kc, D): once, for the face and the tally

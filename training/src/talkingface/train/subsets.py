@@ -41,7 +41,8 @@ def sentences(ds, split: str) -> dict[str, str]:
 
 
 def member(row: dict, part: str) -> bool:
-    """Whether an evaluated clip's row (with "source" and "sentence_heard") belongs to `part`."""
+    """Whether an evaluated clip's row (with "source" and "sentence_heard": None where its sentence is not known)
+    belongs to `part`."""
     human = row["source"] == "human"
     return {"all": True, "synthetic": not human, "human": human,
-            "human_unheard": human and not row.get("sentence_heard", False)}[part]
+            "human_unheard": human and row.get("sentence_heard") is False}[part]

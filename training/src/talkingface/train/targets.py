@@ -59,9 +59,10 @@ def measures(res: dict, part: str) -> list[dict]:
         if value is not None and (low is not None or high is not None):
             met = (low is None or value >= low) and (high is None or (value < high if strict else value <= high))
         # false: (the prediction's false-alarm rate, the truth's): a hit rate is no evidence without them.
-        fa, fa_high = (false[0], false[1] + (1 - low)) if false else (None, None)
+        fa = false[0] if false else None
+        fa_high = false[1] + (1 - low) if false and false[1] is not None else None  # (no truth: no segments to count)
         if met and false:
-            met = fa is not None and fa <= fa_high
+            met = fa is not None and fa_high is not None and fa <= fa_high + 1e-9  # (0.0 + (1 - 0.9) is 0.0999...)
         rows.append({"issue": issue, "measure": name, "value": value, "low": low, "high": high, "unit": unit,
                      "strict": strict, "met": met, "false_alarms": fa, "false_alarms_high": fa_high})
 
