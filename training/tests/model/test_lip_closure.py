@@ -110,3 +110,13 @@ def test_a_face_with_its_lips_shut_keeps_them_touching_and_opens_as_the_model_op
     assert np.allclose(lc.apply(opening), opening)   # an opening is the model's
     o = np.concatenate([closing, opening, 0.5 * closing]).astype(np.float32)
     assert np.abs(LipClosureTorch(lc).apply(torch.from_numpy(o)).numpy() - lc.apply(o)).max() < 1e-4
+
+
+def test_the_calibration_finds_the_gap_the_model_closes_by(template):
+    # A model that closes the reference face's lips exactly (its rig's full closure) is calibrated to that face's gap.
+    from talkingface.model.lip_closure import fit
+    face, ref_gap, _, closing, opening = _reference(template)
+    segments = [(face, np.concatenate([opening, s * closing])) for s in (0.9, 1.0, 1.1)]
+    ref, raw = fit(segments, template)
+    assert abs(raw) < 0.1                 # the model's own offsets shut the median segment
+    assert abs(ref - ref_gap) < 0.1, (ref, ref_gap)
