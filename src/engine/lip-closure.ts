@@ -34,8 +34,9 @@ function bracket(x: number, xs: number[]): [number, number] {
 }
 
 export class LipClosure {
-  /** The vertices it moves, and per vertex: the two upper- and lower-contour vertices around its x and weights. */
-  private readonly active: Int32Array;
+  /** The vertices it moves (the lips' tissue: where they part, and where they touch), and per vertex: the two upper-
+   * and lower-contour vertices around its x and weights. */
+  private readonly moved: Int32Array;
   private readonly up: Int32Array;
   private readonly lo: Int32Array;
   private readonly tUp: Float64Array;
@@ -78,7 +79,7 @@ export class LipClosure {
       const g = Math.max(yu - yl, 0);
       if (w !== 0) rows.push({ i, ku, tu, kl, tl, g, w });
     }
-    this.active = Int32Array.from(rows, (r) => r.i);
+    this.moved = Int32Array.from(rows, (r) => r.i);
     this.up = Int32Array.from(rows.flatMap((r) => [f.upperLip[r.ku], f.upperLip[r.ku + 1]]));
     this.lo = Int32Array.from(rows.flatMap((r) => [f.lowerLip[r.kl], f.lowerLip[r.kl + 1]]));
     this.tUp = Float64Array.from(rows, (r) => r.tu);
@@ -90,13 +91,13 @@ export class LipClosure {
 
   /** Vertices it can move (the lips' tissue). */
   get vertexCount(): number {
-    return this.active.length;
+    return this.moved.length;
   }
 
   /** `offsets` (frames x N x 3, mm), the model's displacement: the mouth's amplitude scaled and the lips closed by
    * the face's own gap, in place. */
   apply(offsets: Float32Array, frames: number, n: number): void {
-    const m = this.active.length;
+    const m = this.moved.length;
     const dy = new Float64Array(m);
     for (let fr = 0; fr < frames; fr++) {
       for (let k = 0; k < this.scaled.length; k++) {
@@ -116,7 +117,7 @@ export class LipClosure {
         const c = Math.min(1, Math.max(0, -(du - dl) / this.ref[k]));
         dy[k] = c * (this.gap[k] - this.ref[k]) * this.field[k];
       }
-      for (let k = 0; k < m; k++) offsets[base + 3 * this.active[k]] += dy[k];
+      for (let k = 0; k < m; k++) offsets[base + 3 * this.moved[k]] += dy[k];
     }
   }
 }
